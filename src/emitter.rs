@@ -1,0 +1,161 @@
+//! How a renderer describes its lights to the crate, and the shading point a
+//! query is made from.
+
+use crate::math::{Aabb, LightCone};
+use glam::Vec3;
+
+/// The lights of a scene as the crate sees them: the renderer implements this
+/// for its own light list (or uses `[Emitter]`).
+///
+/// Emitters are identified by their index `0..len()`. An environment
+/// (infinite) light is not an emitter: the samplers handle it beside the
+/// tree.
+pub trait Emitters {
+    /// How many emitters.
+    fn len(&self) -> usize;
+
+    /// True when there are none.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// World-space bounds of emitter `i` (a point light is a point box).
+    fn bounds(&self, i: usize) -> Aabb;
+
+    /// Emitted power (flux) of emitter `i`, in any consistent unit. Must be
+    /// finite and non-negative.
+    fn power(&self, i: usize) -> f32;
+
+    /// Surface area of emitter `i` (0 for point and directional lights).
+    fn area(&self, i: usize) -> f32;
+
+    /// Directions emitter `i` emits into; `None` for omnidirectional lights.
+    fn cone(&self, i: usize) -> Option<LightCone>;
+
+    /// Whether emitter `i` emits from both sides of its surface.
+    fn two_sided(&self, _i: usize) -> bool {
+        false
+    }
+
+    /// Whether emitter `i` is a delta light (point or spot): it cannot be hit
+    /// by BSDF sampling, so only light sampling reaches it.
+    fn is_delta(&self, _i: usize) -> bool {
+        false
+    }
+}
+
+/// A plain description of one emitter, for renderers that would rather hand
+/// over a list than implement [`Emitters`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Emitter {
+    /// World-space bounds.
+    pub bounds: Aabb,
+    /// Emitted power (flux).
+    pub power: f32,
+    /// Surface area.
+    pub area: f32,
+    /// Emission directions; `None` for omnidirectional.
+    pub cone: Option<LightCone>,
+    /// Emits from both sides.
+    pub two_sided: bool,
+    /// Point or spot light.
+    pub delta: bool,
+}
+
+impl Emitter {
+    /// An isotropic point light.
+    pub fn point(position: Vec3, power: f32) -> Self {
+        Self {
+            bounds: Aabb::from_point(position),
+            power,
+            area: 0.0,
+            cone: None,
+            two_sided: false,
+            delta: true,
+        }
+    }
+
+    /// A one-sided Lambertian planar emitter (quad, triangle, disk) with the
+    /// given bounds, normal and area.
+    pub fn area(bounds: Aabb, normal: Vec3, area: f32, power: f32) -> Self {
+        Self {
+            bounds,
+            power,
+            area,
+            cone: Some(LightCone::lambertian(normal)),
+            two_sided: false,
+            delta: false,
+        }
+    }
+
+    /// A spherical emitter: emits in every direction from its surface.
+    pub fn sphere(center: Vec3, radius: f32, power: f32) -> Self {
+        Self {
+            bounds: Aabb::new(center - Vec3::splat(radius), center + Vec3::splat(radius)),
+            power,
+            area: 4.0 * core::f32::consts::PI * radius * radius,
+            cone: None,
+            two_sided: false,
+            delta: false,
+        }
+    }
+}
+
+/// Implements [`Emitters`] for a container that derefs to `[Emitter]`.
+macro_rules! emitters_for_list {
+    ($($t:ty),*) => {$(
+        impl Emitters for $t {
+            fn len(&self) -> usize {
+                <[Emitter]>::len(self)
+            }
+            fn bounds(&self, i: usize) -> Aabb {
+                self[i].bounds
+            }
+            fn power(&self, i: usize) -> f32 {
+                self[i].power
+            }
+            fn area(&self, i: usize) -> f32 {
+                self[i].area
+            }
+            fn cone(&self, i: usize) -> Option<LightCone> {
+                self[i].cone
+            }
+            fn two_sided(&self, i: usize) -> bool {
+                self[i].two_sided
+            }
+            fn is_delta(&self, i: usize) -> bool {
+                self[i].delta
+            }
+        }
+    )*};
+}
+
+emitters_for_list!([Emitter], alloc::vec::Vec<Emitter>);
+
+/// The shading point a light is chosen for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadingContext {
+    /// World-space position.
+    pub position: Vec3,
+    /// Unit surface normal; `None` in media or when unknown. Importance-based
+    /// samplers use it to discount lights behind the surface.
+    pub normal: Option<Vec3>,
+}
+
+impl ShadingContext {
+    /// A context at `position` with no normal.
+    pub fn at(position: Vec3) -> Self {
+        Self {
+            position,
+            normal: None,
+        }
+    }
+
+    /// A context on a surface.
+    pub fn on_surface(position: Vec3, normal: Vec3) -> Self {
+        Self {
+            position,
+            normal: normal.try_normalize(),
+        }
+    }
+}

@@ -1,0 +1,56 @@
+//! Light selection for next-event estimation: one trait, several samplers.
+//!
+//! Every sampler answers two questions for a shading point: *which light?*
+//! ([`LightSampler::sample`], driven by one uniform number so any sampler,
+//! QMC included, can feed it) and *with what probability?*
+//! ([`LightSampler::pmf`]). The two agree bit for bit, and the pmf sums to 1
+//! over all lights (or is 0 everywhere when nothing can be sampled).
+//!
+//! | sampler | rule |
+//! | --- | --- |
+//! | [`UniformSampler`] | every emitter equally |
+//! | [`PowerSampler`] | proportional to power (alias table, O(1)) |
+//! | [`EnergyTreeSampler`] | descend a light tree by subtree energy |
+//! | [`ImportanceTreeSampler`] | descend by power x orientation / distance^2 (Estevez & Kulla, pbrt-v4) |
+//! | [`WithEnvironment`] | any of the above plus an environment light with a fixed probability |
+//! | [`crate::glt`] | the Guiding Light Tree: learned cuts, then the light tree |
+
+use crate::emitter::ShadingContext;
+
+/// A light a sampler can choose.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum LightId {
+    /// Emitter `i` of the scene's [`crate::Emitters`].
+    Emitter(u32),
+    /// The environment (infinite) light, handled beside the emitters.
+    Environment,
+}
+
+/// A chosen light and the probability it was chosen with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightSample {
+    /// The light.
+    pub light: LightId,
+    /// Its probability, in `(0, 1]`; equal to what [`LightSampler::pmf`]
+    /// returns for it.
+    pub pmf: f32,
+}
+
+/// Chooses lights for next-event estimation.
+///
+/// Implementations take `&self` and are `Sync` when their data is, so a
+/// renderer shares one sampler between all its threads.
+pub trait LightSampler {
+    /// Chooses a light at `ctx` from one uniform number `u` in `[0, 1)`
+    /// (values outside are clamped). `None` when no light can be chosen:
+    /// no emitters, or every one has zero power.
+    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample>;
+
+    /// The probability that [`LightSampler::sample`] chooses `light` at
+    /// `ctx`: exactly the `pmf` it returns for it, and 0 for lights it never
+    /// chooses (including ids out of range).
+    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32;
+
+    /// True when `sample` returns `None` at every shading point.
+    fn is_empty(&self) -> bool;
+}

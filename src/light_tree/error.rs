@@ -1,0 +1,66 @@
+use core::fmt;
+
+/// Why a light tree could not be built. Every variant names the offending
+/// emitter so a renderer can report it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BuildError {
+    /// An emitter's bounds are empty, NaN or infinite.
+    InvalidBounds {
+        /// The emitter's index.
+        emitter: usize,
+    },
+    /// An emitter's power is NaN, infinite or negative.
+    InvalidPower {
+        /// The emitter's index.
+        emitter: usize,
+        /// The power it reported.
+        power: f32,
+    },
+    /// An emitter's area is NaN, infinite or negative.
+    InvalidArea {
+        /// The emitter's index.
+        emitter: usize,
+        /// The area it reported.
+        area: f32,
+    },
+    /// An emitter's cone has a non-finite axis or angle.
+    InvalidCone {
+        /// The emitter's index.
+        emitter: usize,
+    },
+    /// More emitters than node indices can address (2^31 - 1).
+    TooManyEmitters {
+        /// How many were given.
+        count: usize,
+    },
+    /// The total power does not fit in an `f32`.
+    PowerOverflow,
+}
+
+impl fmt::Display for BuildError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::InvalidBounds { emitter } => {
+                write!(f, "emitter {emitter} has empty or non-finite bounds")
+            }
+            Self::InvalidPower { emitter, power } => {
+                write!(f, "emitter {emitter} has invalid power {power}")
+            }
+            Self::InvalidArea { emitter, area } => {
+                write!(f, "emitter {emitter} has invalid area {area}")
+            }
+            Self::InvalidCone { emitter } => {
+                write!(f, "emitter {emitter} has a non-finite emission cone")
+            }
+            Self::TooManyEmitters { count } => {
+                write!(
+                    f,
+                    "{count} emitters exceed the 2^31 - 1 a light tree can index"
+                )
+            }
+            Self::PowerOverflow => f.write_str("the total emitted power overflows f32"),
+        }
+    }
+}
+
+impl core::error::Error for BuildError {}

@@ -1,0 +1,70 @@
+use super::EmitterPath;
+use crate::math::{Aabb, LightCone, Side};
+
+/// What a tree node knows about the lights below it: enough for the
+/// importance heuristics of Estevez & Kulla and pbrt-v4.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NodeBounds {
+    /// Bounds of every emitter below (conservative).
+    pub bounds: Aabb,
+    /// Bound of their emission directions (conservative).
+    pub cone: LightCone,
+    /// Whether any emitter below is two-sided.
+    pub two_sided: bool,
+    /// Total power below.
+    pub energy: f32,
+}
+
+/// A binary light hierarchy with one emitter per leaf.
+///
+/// Nodes are named by `u32` indices. Every emitter `0..emitter_count()` has
+/// exactly one leaf. Implementations answer in O(1) per call except
+/// [`LightHierarchy::path`], which is O(depth) and has no depth limit.
+pub trait LightHierarchy {
+    /// The root; `None` when there are no emitters.
+    fn root(&self) -> Option<u32>;
+
+    /// The two children of an inner node; `None` for a leaf.
+    fn children(&self, node: u32) -> Option<[u32; 2]>;
+
+    /// The parent of `node`; `None` for the root.
+    fn parent(&self, node: u32) -> Option<u32>;
+
+    /// Total power (energy) of the emitters below `node`.
+    fn energy(&self, node: u32) -> f32;
+
+    /// Spatial and directional bounds of the emitters below `node`.
+    fn node_bounds(&self, node: u32) -> NodeBounds;
+
+    /// The emitter of a leaf; `None` for an inner node.
+    fn emitter(&self, node: u32) -> Option<u32>;
+
+    /// The leaf of `emitter`; `None` when out of range.
+    fn leaf(&self, emitter: u32) -> Option<u32>;
+
+    /// Number of nodes.
+    fn node_count(&self) -> usize;
+
+    /// Number of emitters (leaves).
+    fn emitter_count(&self) -> usize;
+
+    /// The root-to-leaf path of `emitter`, at any depth; `None` when out of
+    /// range.
+    fn path(&self, emitter: u32) -> Option<EmitterPath> {
+        let mut node = self.leaf(emitter)?;
+        let mut path = EmitterPath::new();
+        path.push_leaf(node);
+        while let Some(parent) = self.parent(node) {
+            let [left, _] = self.children(parent)?;
+            let side = if left == node {
+                Side::Left
+            } else {
+                Side::Right
+            };
+            path.push_parent(parent, side);
+            node = parent;
+        }
+        path.finish();
+        Some(path)
+    }
+}

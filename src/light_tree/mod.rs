@@ -1,0 +1,20 @@
+//! The global light hierarchy: a binary tree with one emitter per leaf, the
+//! structure every tree-based sampler and the Guiding Light Tree descend.
+//!
+//! [`LightHierarchy`] is the interface; [`LightTree`] is the BVH that
+//! implements it, built with one of the [`BuildHeuristic`]s.
+
+mod build;
+pub(crate) mod descend;
+mod error;
+mod hierarchy;
+mod node;
+mod path;
+mod tree;
+
+pub use build::BuildHeuristic;
+pub use error::BuildError;
+pub use hierarchy::{LightHierarchy, NodeBounds};
+pub use node::LightNode;
+pub use path::EmitterPath;
+pub use tree::LightTree;

@@ -1,0 +1,17 @@
+//! Math shared by every layer: scalar shims, boxes, cones, the equal-area
+//! sphere map, the exact one-number descent and sums that many threads can
+//! add to.
+
+mod aabb;
+mod cone;
+mod descent;
+pub(crate) mod scalar;
+mod sphere_map;
+mod sum;
+
+pub use aabb::Aabb;
+pub use cone::LightCone;
+pub(crate) use cone::angle_between as cone_angle_between;
+pub use descent::{Descent, Side};
+pub use sphere_map::{SPHERE_MAP_JACOBIAN, canonical_to_dir, dir_to_canonical};
+pub use sum::{Accumulation, SumBuffer};

@@ -1,0 +1,338 @@
+//! Sums that many threads add to through `&self`, without lost updates and
+//! without `f32` accumulation error.
+//!
+//! Two modes, chosen per structure:
+//! - [`Accumulation::Fast`]: one `f64` per sum, added with a compare-and-swap
+//!   loop. No update is lost and a sum only loses precision after ~2^53
+//!   samples of equal size (an `f32` sum stops growing after 2^24), but the
+//!   order in which threads add changes the last bits.
+//! - [`Accumulation::Deterministic`]: an exact fixed-point sum of the `f32`
+//!   inputs (a Kulisch accumulator spread over atomic words). Integer
+//!   addition is associative, so the result is bit-identical whatever the
+//!   number of threads or the order of additions. It costs 48 bytes per sum.
+//!
+//! Targets without 64-bit atomics (e.g. `thumbv7em`) always use the exact
+//! accumulator on 32-bit words.
+
+use alloc::vec::Vec;
+
+#[cfg(not(target_has_atomic = "64"))]
+use core::sync::atomic::AtomicU32 as Word;
+#[cfg(target_has_atomic = "64")]
+use core::sync::atomic::AtomicU64 as Word;
+use core::sync::atomic::Ordering::Relaxed;
+
+#[cfg(target_has_atomic = "64")]
+type Raw = u64;
+#[cfg(not(target_has_atomic = "64"))]
+type Raw = u32;
+
+const WORD_BITS: u32 = Raw::BITS;
+/// An f32 is `m * 2^(s - 149)` with `m < 2^24` and `s <= 253`: 277 bits, plus
+/// headroom for 2^64 additions, fits in 384 bits.
+const EXACT_BITS: u32 = 384;
+const EXACT_WORDS: usize = (EXACT_BITS / WORD_BITS) as usize;
+
+/// How a structure accumulates its training sums.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Accumulation {
+    /// `f64` atomic sums: fast, small, exact enough, not bit-reproducible
+    /// across thread counts.
+    #[default]
+    Fast,
+    /// Exact sums: bit-identical learned state for the same inputs whatever
+    /// the thread count or order. Uses 48 bytes per sum.
+    Deterministic,
+}
+
+/// A fixed number of non-negative sums that can be added to concurrently.
+#[derive(Debug)]
+pub struct SumBuffer {
+    words: Vec<Word>,
+    stride: usize,
+}
+
+impl SumBuffer {
+    /// `len` sums, all zero.
+    pub fn new(len: usize, mode: Accumulation) -> Self {
+        let stride = Self::stride_of(mode);
+        let mut words = Vec::with_capacity(len * stride);
+        words.resize_with(len * stride, || Word::new(0));
+        Self { words, stride }
+    }
+
+    fn stride_of(mode: Accumulation) -> usize {
+        match mode {
+            #[cfg(target_has_atomic = "64")]
+            Accumulation::Fast => 1,
+            _ => EXACT_WORDS,
+        }
+    }
+
+    /// The mode the sums were created with.
+    pub fn mode(&self) -> Accumulation {
+        if self.stride == 1 {
+            Accumulation::Fast
+        } else {
+            Accumulation::Deterministic
+        }
+    }
+
+    /// How many sums.
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.words.len() / self.stride
+    }
+
+    /// True when there are no sums.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.words.is_empty()
+    }
+
+    /// Bytes of storage.
+    pub fn bytes(&self) -> usize {
+        self.words.len() * core::mem::size_of::<Word>()
+    }
+
+    /// Adds `value` to sum `index`. Values that are negative, NaN or infinite
+    /// and indices out of range are ignored (callers validate and count bad
+    /// input before this point); returns whether it was added.
+    #[inline]
+    pub fn add(&self, index: usize, value: f32) -> bool {
+        if !(value >= 0.0 && value.is_finite()) || index >= self.len() {
+            return false;
+        }
+        if value == 0.0 {
+            return true;
+        }
+        let words = &self.words[index * self.stride..(index + 1) * self.stride];
+        #[cfg(target_has_atomic = "64")]
+        if self.stride == 1 {
+            add_f64(&words[0], value as f64);
+            return true;
+        }
+        add_exact(words, value);
+        true
+    }
+
+    /// The value of sum `index` (0 out of range). Call it when no thread is
+    /// adding (between iterations); a read racing with adds sees some of them.
+    #[inline]
+    pub fn get(&self, index: usize) -> f64 {
+        if index >= self.len() {
+            return 0.0;
+        }
+        let words = &self.words[index * self.stride..(index + 1) * self.stride];
+        #[cfg(target_has_atomic = "64")]
+        if self.stride == 1 {
+            return f64::from_bits(words[0].load(Relaxed));
+        }
+        exact_value(words)
+    }
+
+    /// Sets every sum to zero.
+    pub fn clear(&mut self) {
+        for w in &mut self.words {
+            *w.get_mut() = 0;
+        }
+    }
+
+    /// Resizes to `len` sums, all zero.
+    pub fn reset(&mut self, len: usize) {
+        self.words.clear();
+        self.words.resize_with(len * self.stride, || Word::new(0));
+    }
+}
+
+impl Clone for SumBuffer {
+    fn clone(&self) -> Self {
+        Self {
+            words: self
+                .words
+                .iter()
+                .map(|w| Word::new(w.load(Relaxed)))
+                .collect(),
+            stride: self.stride,
+        }
+    }
+}
+
+#[cfg(target_has_atomic = "64")]
+#[inline]
+fn add_f64(word: &Word, value: f64) {
+    let mut old = word.load(Relaxed);
+    loop {
+        let new = (f64::from_bits(old) + value).to_bits();
+        match word.compare_exchange_weak(old, new, Relaxed, Relaxed) {
+            Ok(_) => return,
+            Err(actual) => old = actual,
+        }
+    }
+}
+
+/// Adds an exact positive f32 to the fixed-point words (LSB = 2^-149).
+#[inline]
+fn add_exact(words: &[Word], value: f32) {
+    let bits = value.to_bits();
+    let exp = (bits >> 23) & 0xff;
+    let frac = bits & 0x7f_ffff;
+    let (mantissa, shift) = if exp == 0 {
+        (frac as u128, 0u32)
+    } else {
+        ((frac | 0x80_0000) as u128, exp - 1)
+    };
+    let word = (shift / WORD_BITS) as usize;
+    let wide = mantissa << (shift % WORD_BITS);
+    let mut part = wide;
+    let mut k = word;
+    while part != 0 && k < words.len() {
+        add_word(words, k, part as Raw);
+        part >>= WORD_BITS;
+        k += 1;
+    }
+}
+
+/// Adds to word `k`, carrying into the words above on overflow. Every step is
+/// an atomic add, so the final integer is exact whatever the interleaving.
+#[inline]
+fn add_word(words: &[Word], mut k: usize, mut x: Raw) {
+    while x != 0 && k < words.len() {
+        let old = words[k].fetch_add(x, Relaxed);
+        x = Raw::from(old.checked_add(x).is_none());
+        k += 1;
+    }
+}
+
+/// The exact sum rounded to f64, the same for the same integer.
+fn exact_value(words: &[Word]) -> f64 {
+    let mut value = 0.0f64;
+    for (k, w) in words.iter().enumerate().rev() {
+        let x = w.load(Relaxed);
+        if x != 0 {
+            let scale = (k as i32) * WORD_BITS as i32 - 149;
+            value += x as f64 * pow2(scale);
+        }
+    }
+    value
+}
+
+/// 2^e for e in the range the accumulator uses, exactly.
+fn pow2(e: i32) -> f64 {
+    // Split so each factor is a normal f64.
+    let mut v = 1.0f64;
+    let mut e = e;
+    while e > 1000 {
+        v *= 2f64.powi(1000);
+        e -= 1000;
+    }
+    while e < -1000 {
+        v *= 2f64.powi(-1000);
+        e += 1000;
+    }
+    v * f64::from_bits(((e + 1023) as u64) << 52)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fast_mode_keeps_small_increments() {
+        let s = SumBuffer::new(1, Accumulation::Fast);
+        s.add(0, 1.0e8);
+        for _ in 0..1000 {
+            s.add(0, 1.0);
+        }
+        // An f32 sum would have stayed at 1e8.
+        assert_eq!(s.get(0), 1.0e8 + 1000.0);
+    }
+
+    #[test]
+    fn exact_mode_is_exact_and_order_free() {
+        let values = [
+            3.0e30f32,
+            1.0e-40,
+            7.25,
+            1.0e-30,
+            0.1,
+            3.0e30,
+            2.0f32.powi(-149),
+        ];
+        let a = SumBuffer::new(1, Accumulation::Deterministic);
+        let b = SumBuffer::new(1, Accumulation::Deterministic);
+        for v in values {
+            a.add(0, v);
+        }
+        for v in values.iter().rev() {
+            b.add(0, *v);
+        }
+        assert_eq!(a.get(0).to_bits(), b.get(0).to_bits());
+        let expect: f64 = values.iter().map(|&v| v as f64).sum();
+        assert!((a.get(0) - expect).abs() <= expect * 1e-15);
+    }
+
+    #[test]
+    fn exact_mode_carries() {
+        let s = SumBuffer::new(1, Accumulation::Deterministic);
+        // Largest f32: fills the top of the mantissa range; repeated adds
+        // carry into higher words.
+        for _ in 0..1000 {
+            s.add(0, f32::MAX);
+        }
+        assert_eq!(s.get(0), f32::MAX as f64 * 1000.0);
+        let small = SumBuffer::new(1, Accumulation::Deterministic);
+        for _ in 0..(1 << 12) {
+            small.add(0, 1.0);
+        }
+        assert_eq!(small.get(0), 4096.0);
+    }
+
+    #[test]
+    fn rejects_bad_values_and_indices() {
+        for mode in [Accumulation::Fast, Accumulation::Deterministic] {
+            let s = SumBuffer::new(2, mode);
+            assert!(!s.add(0, -1.0));
+            assert!(!s.add(0, f32::NAN));
+            assert!(!s.add(0, f32::INFINITY));
+            assert!(!s.add(2, 1.0));
+            assert!(s.add(1, 2.0));
+            assert_eq!(s.get(0), 0.0);
+            assert_eq!(s.get(1), 2.0);
+            assert_eq!(s.get(9), 0.0);
+        }
+    }
+
+    #[test]
+    fn clear_and_reset() {
+        let mut s = SumBuffer::new(3, Accumulation::Deterministic);
+        s.add(2, 5.0);
+        s.clear();
+        assert_eq!(s.get(2), 0.0);
+        s.reset(5);
+        assert_eq!(s.len(), 5);
+        assert_eq!(s.mode(), Accumulation::Deterministic);
+        assert_eq!(s.bytes(), 5 * 48);
+    }
+
+    #[cfg(feature = "std")]
+    #[test]
+    fn threads_lose_no_update() {
+        extern crate std;
+        for mode in [Accumulation::Fast, Accumulation::Deterministic] {
+            let s = SumBuffer::new(4, mode);
+            std::thread::scope(|scope| {
+                for t in 0..4 {
+                    let s = &s;
+                    scope.spawn(move || {
+                        for i in 0..10_000 {
+                            s.add(i % 4, (t + 1) as f32 * 0.5);
+                        }
+                    });
+                }
+            });
+            let total: f64 = (0..4).map(|i| s.get(i)).sum();
+            assert_eq!(total, 10_000.0 * (0.5 + 1.0 + 1.5 + 2.0));
+        }
+    }
+}

@@ -1,0 +1,1 @@
+//! The directional quadtree of Practical Path Guiding over the equal-area sphere map.
