@@ -63,5 +63,8 @@ pub mod sd_tree;
 pub mod spatial;
 
 pub use emitter::{Emitter, Emitters, ShadingContext};
-pub use light_sampler::{LightId, LightSample, LightSampler};
+pub use light_sampler::{
+    EnergyTreeSampler, ImportanceTreeSampler, LightId, LightSample, LightSampler, PowerSampler,
+    UniformSampler, WithEnvironment,
+};
 pub use light_tree::{LightHierarchy, LightTree};

@@ -15,7 +15,23 @@
 //! | [`WithEnvironment`] | any of the above plus an environment light with a fixed probability |
 //! | [`crate::glt`] | the Guiding Light Tree: learned cuts, then the light tree |
 
+mod environment;
+mod importance;
+mod power;
+mod tree_energy;
+mod tree_importance;
+mod uniform;
+
+pub use environment::WithEnvironment;
+pub use importance::importance;
+pub use power::PowerSampler;
+pub use tree_energy::EnergyTreeSampler;
+pub use tree_importance::ImportanceTreeSampler;
+pub use uniform::UniformSampler;
+
 use crate::emitter::ShadingContext;
+
+pub(crate) use crate::math::pmf_to_f32;
 
 /// A light a sampler can choose.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -53,4 +69,38 @@ pub trait LightSampler {
 
     /// True when `sample` returns `None` at every shading point.
     fn is_empty(&self) -> bool;
+}
+
+impl<S: LightSampler + ?Sized> LightSampler for &S {
+    #[inline]
+    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+        (**self).sample(ctx, u)
+    }
+
+    #[inline]
+    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        (**self).pmf(ctx, light)
+    }
+
+    #[inline]
+    fn is_empty(&self) -> bool {
+        (**self).is_empty()
+    }
+}
+
+impl<S: LightSampler + ?Sized> LightSampler for alloc::boxed::Box<S> {
+    #[inline]
+    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+        (**self).sample(ctx, u)
+    }
+
+    #[inline]
+    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        (**self).pmf(ctx, light)
+    }
+
+    #[inline]
+    fn is_empty(&self) -> bool {
+        (**self).is_empty()
+    }
 }

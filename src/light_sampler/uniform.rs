@@ -1,0 +1,101 @@
+//! Uniform light selection: the baseline every other sampler is measured
+//! against.
+
+use super::{LightId, LightSample, LightSampler, pmf_to_f32};
+use crate::emitter::ShadingContext;
+use crate::math::Descent;
+
+/// The most emitters a [`LightId::Emitter`] can name.
+const MAX_EMITTERS: u64 = u32::MAX as u64 + 1;
+
+/// Chooses every emitter with the same probability `1 / count`, whatever its
+/// power or position.
+///
+/// `u` maps to emitter `floor(u * count)` (an inverse CDF, so stratified `u`
+/// stays stratified). Counts beyond 2^32 are capped at 2^32, the number of
+/// ids a [`LightId::Emitter`] can hold. With `count == 0` nothing is
+/// sampled.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UniformSampler {
+    count: u64,
+    pmf: f32,
+}
+
+impl UniformSampler {
+    /// A sampler over emitters `0..count`.
+    pub fn new(count: usize) -> Self {
+        let count = (count as u64).min(MAX_EMITTERS);
+        let pmf = if count == 0 {
+            0.0
+        } else {
+            pmf_to_f32(1.0 / count as f64)
+        };
+        Self { count, pmf }
+    }
+
+    /// Number of emitters it chooses from.
+    pub fn count(&self) -> usize {
+        self.count as usize
+    }
+}
+
+impl LightSampler for UniformSampler {
+    #[inline]
+    fn sample(&self, _ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+        if self.is_empty() {
+            return None;
+        }
+        let u = Descent::new(u).u();
+        // u >= 0, so truncation is floor (and avoids a libm call).
+        let i = ((u * self.count as f64) as u64).min(self.count - 1);
+        Some(LightSample {
+            light: LightId::Emitter(i as u32),
+            pmf: self.pmf,
+        })
+    }
+
+    #[inline]
+    fn pmf(&self, _ctx: &ShadingContext, light: LightId) -> f32 {
+        match light {
+            LightId::Emitter(i) if (i as u64) < self.count => self.pmf,
+            _ => 0.0,
+        }
+    }
+
+    #[inline]
+    fn is_empty(&self) -> bool {
+        self.count == 0 || self.pmf == 0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn inverse_cdf_and_edges() {
+        let s = UniformSampler::new(4);
+        let ctx = ShadingContext::at(Vec3::ZERO);
+        let pick = |u: f32| s.sample(&ctx, u).map(|x| x.light);
+        assert_eq!(pick(0.0), Some(LightId::Emitter(0)));
+        assert_eq!(pick(0.2499), Some(LightId::Emitter(0)));
+        assert_eq!(pick(0.25), Some(LightId::Emitter(1)));
+        assert_eq!(pick(0.99999994), Some(LightId::Emitter(3)));
+        assert_eq!(pick(1.0), Some(LightId::Emitter(3)));
+        assert_eq!(pick(f32::NAN), Some(LightId::Emitter(0)));
+        assert_eq!(pick(f32::INFINITY), Some(LightId::Emitter(3)));
+        assert_eq!(s.pmf(&ctx, LightId::Emitter(3)), 0.25);
+        assert_eq!(s.pmf(&ctx, LightId::Emitter(4)), 0.0);
+        assert_eq!(s.pmf(&ctx, LightId::Environment), 0.0);
+    }
+
+    #[test]
+    fn empty_samples_nothing() {
+        let s = UniformSampler::new(0);
+        let ctx = ShadingContext::at(Vec3::ZERO);
+        assert!(s.is_empty());
+        assert_eq!(s.sample(&ctx, 0.5), None);
+        assert_eq!(s.pmf(&ctx, LightId::Emitter(0)), 0.0);
+    }
+}
