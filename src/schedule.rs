@@ -1,1 +1,0 @@
-//! Iteration schedule of guided rendering and the inverse-variance combination of its last iterations.

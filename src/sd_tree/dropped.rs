@@ -1,0 +1,92 @@
+//! Counting the bad input that splats and fraction records drop.
+
+#[cfg(not(target_has_atomic = "64"))]
+use core::sync::atomic::AtomicU32 as AtomicCount;
+#[cfg(target_has_atomic = "64")]
+use core::sync::atomic::AtomicU64 as AtomicCount;
+use core::sync::atomic::Ordering::Relaxed;
+
+/// Why a splat or fraction record was dropped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum DropReason {
+    /// The position has a NaN or infinite coordinate.
+    Position,
+    /// The direction is NaN, infinite or of zero length.
+    Direction,
+    /// The radiance (or a fraction record's contribution) is NaN, infinite
+    /// or negative.
+    Radiance,
+    /// A pdf is zero, negative, NaN or infinite (for a fraction record: a
+    /// pdf is negative or non-finite, or both are zero).
+    Pdf,
+    /// `radiance / pdf` overflowed `f32`.
+    Overflow,
+}
+
+const REASONS: usize = 5;
+
+/// Snapshot of how many splats and fraction records were dropped, per
+/// reason. Dropped input is never stored.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct DroppedSplats {
+    /// Non-finite positions.
+    pub position: u64,
+    /// NaN, infinite or zero-length directions.
+    pub direction: u64,
+    /// NaN, infinite or negative radiance or contribution.
+    pub radiance: u64,
+    /// Zero, negative or non-finite pdfs.
+    pub pdf: u64,
+    /// `radiance / pdf` not representable in `f32`.
+    pub overflow: u64,
+}
+
+impl DroppedSplats {
+    /// All dropped inputs.
+    pub fn total(&self) -> u64 {
+        self.position + self.direction + self.radiance + self.pdf + self.overflow
+    }
+}
+
+/// Lock-free per-reason counters (wrap around only after 2^64 drops, 2^32
+/// on targets without 64-bit atomics).
+#[derive(Debug, Default)]
+pub(crate) struct DropCounters {
+    counts: [AtomicCount; REASONS],
+}
+
+impl DropCounters {
+    #[inline]
+    pub(crate) fn count(&self, reason: DropReason) {
+        self.counts[reason as usize].fetch_add(1, Relaxed);
+    }
+
+    pub(crate) fn snapshot(&self) -> DroppedSplats {
+        // A no-op cast where the counters are 64-bit, a widening elsewhere.
+        #[allow(clippy::unnecessary_cast)]
+        let get = |r: DropReason| self.counts[r as usize].load(Relaxed) as u64;
+        DroppedSplats {
+            position: get(DropReason::Position),
+            direction: get(DropReason::Direction),
+            radiance: get(DropReason::Radiance),
+            pdf: get(DropReason::Pdf),
+            overflow: get(DropReason::Overflow),
+        }
+    }
+
+    pub(crate) fn reset(&mut self) {
+        for c in &mut self.counts {
+            *c.get_mut() = 0;
+        }
+    }
+}
+
+impl Clone for DropCounters {
+    fn clone(&self) -> Self {
+        let s = Self::default();
+        for (a, b) in s.counts.iter().zip(&self.counts) {
+            a.store(b.load(Relaxed), Relaxed);
+        }
+        s
+    }
+}
