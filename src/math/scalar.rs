@@ -32,10 +32,6 @@ mod imp {
         x.floor()
     }
     #[inline]
-    pub fn floor64(x: f64) -> f64 {
-        x.floor()
-    }
-    #[inline]
     pub fn ceil(x: f32) -> f32 {
         x.ceil()
     }
@@ -78,10 +74,6 @@ mod imp {
     #[inline]
     pub fn floor(x: f32) -> f32 {
         libm::floorf(x)
-    }
-    #[inline]
-    pub fn floor64(x: f64) -> f64 {
-        libm::floor(x)
     }
     #[inline]
     pub fn ceil(x: f32) -> f32 {

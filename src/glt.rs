@@ -1,1 +1,0 @@
-//! The Guiding Light Tree: learned adaptive cuts through the light tree, per spatial cell.

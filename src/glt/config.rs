@@ -1,0 +1,128 @@
+//! Parameters of the Guiding Light Tree: the per-cell cut ([`CutConfig`]).
+
+use crate::math::Accumulation;
+
+/// How the cut's sampling continues below the cut, inside the cluster a cut
+/// slot stands for.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum BelowCut {
+    /// By the light tree's subtree energy, as the paper does (one read of
+    /// the [`GuidingTree`](super::GuidingTree)'s split table per level);
+    /// independent of the shading point.
+    #[default]
+    Energy,
+    /// By the Estevez-Kulla / pbrt-v4 importance (power x orientation /
+    /// distance^2) at the shading point, the paper's suggestion for future
+    /// work. Where both children have zero importance the step falls back to
+    /// energy, so the cut component stays a proper distribution.
+    ///
+    /// Measured in the synthetic scene described at [`CutConfig::alpha`]
+    /// (`tests/glt_defaults.rs`): 1.5-2.5x lower variance than
+    /// [`BelowCut::Energy`] at equal alpha, for a costlier walk below the
+    /// cut (two node decodes and importance evaluations per level). The
+    /// default stays [`BelowCut::Energy`] until measured in a renderer.
+    Importance,
+}
+
+/// How a slot that is split for the first time shares its learned weight
+/// between its two new children (they have no statistics of their own yet).
+///
+/// Either way a child whose subtree has zero energy gets nothing: its
+/// emitters can never receive a splat, and giving it weight would only lead
+/// the cut into lights that cannot be sampled below it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum SplitPrior {
+    /// Half each, as the paper and its code do. The default, measured
+    /// (`tests/glt_defaults.rs`, 2 training budgets x 2 seeds): against
+    /// [`SplitPrior::Energy`] it gave 0.70-1.04x the variance with energy
+    /// below the cut and 0.82-1.10x with importance (at alpha = 0.2; 6 of 8
+    /// runs lower), most clearly when cells have little data: a fresh split
+    /// that ignores power explores dim but near clusters sooner.
+    #[default]
+    Half,
+    /// In the ratio of the children's subtree energies: a freshly split
+    /// cluster is sampled exactly as it was before the split (below the cut
+    /// it was descended by energy too), so a split alone never changes the
+    /// distribution before the cluster has data.
+    Energy,
+}
+
+/// The parameters of one guiding cut: how it is refined and sampled.
+///
+/// Out-of-range values are not errors: `sigma` is clamped to `[0, 1]`,
+/// `alpha` and the environment probability to `[0, 1]`, and NaN falls back
+/// to the default (see [`CutConfig::sanitized`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CutConfig {
+    /// Split threshold: a slot whose share of its cell's learned total is
+    /// above `sigma` is split (down to single emitters); slots at or below
+    /// end the cut. Default 0.01, the paper's recommendation.
+    pub sigma: f64,
+    /// Weight of the defensive mixture with the energy prior:
+    /// `pmf = (1 - alpha) * learned + alpha * prior`. Every emitter with
+    /// non-zero power keeps a pmf of at least `alpha` times its prior pmf,
+    /// so delta lights stay unbiased without MIS and the variance is never
+    /// more than `1 / alpha` times that of prior sampling (Hesterberg's
+    /// defensive importance sampling bound), while a perfectly learned
+    /// distribution loses at most a factor `1 / (1 - alpha)` in variance.
+    ///
+    /// Default 0.2, measured (`tests/glt_defaults.rs`: 2000 lights in rooms,
+    /// exact variance over 300 points; energy below the cut, half splits):
+    /// the relative variance at alpha = 0.05 / 0.1 / 0.2 / 0.3 / 0.5 was
+    /// 25 / 14-16 / 9.4-11 / 11 / 10.5-11 with little training and
+    /// 7.7-7.9 / 4.6-5.1 / 3.9-4.3 / 3.6 / 4.1-4.3 with ten times more
+    /// (pure prior: 69). Cells learn from few samples, so clusters that
+    /// matter but drew no splat must be caught by the floor; 0.2-0.3 is
+    /// best, and 0.2 costs at most 1.25x against a perfect guide. 0 gives
+    /// the paper's behaviour (biased for delta lights the cut never
+    /// learned).
+    pub alpha: f64,
+    /// How to continue below the cut. Default [`BelowCut::Energy`].
+    pub below_cut: BelowCut,
+    /// How a newly split slot's weight is shared. Default
+    /// [`SplitPrior::Half`].
+    pub split_prior: SplitPrior,
+    /// An environment (infinite) light beside the emitters: `Some(q)` with
+    /// the prior probability `q` of choosing it, `None` for none. The learned
+    /// probability is `env / (env + emitters)` of the splatted values, mixed
+    /// with `q` by `alpha` like the emitters. Default `None`.
+    pub environment: Option<f64>,
+    /// How the training sums accumulate. Default [`Accumulation::Fast`];
+    /// [`Accumulation::Deterministic`] gives bit-identical learned cuts
+    /// whatever the thread count (48 bytes per sum instead of 8).
+    pub accumulation: Accumulation,
+}
+
+impl Default for CutConfig {
+    fn default() -> Self {
+        Self {
+            sigma: 0.01,
+            alpha: 0.2,
+            below_cut: BelowCut::Energy,
+            split_prior: SplitPrior::Half,
+            environment: None,
+            accumulation: Accumulation::Fast,
+        }
+    }
+}
+
+impl CutConfig {
+    /// The configuration with every number clamped into its range (NaN
+    /// replaced by the default). The cut code only ever uses this form.
+    pub fn sanitized(&self) -> Self {
+        let d = Self::default();
+        let unit = |x: f64, default: f64| {
+            if x.is_nan() {
+                default
+            } else {
+                x.clamp(0.0, 1.0)
+            }
+        };
+        Self {
+            sigma: unit(self.sigma, d.sigma),
+            alpha: unit(self.alpha, d.alpha),
+            environment: self.environment.map(|q| unit(q, 0.0)),
+            ..*self
+        }
+    }
+}

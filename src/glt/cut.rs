@@ -1,0 +1,260 @@
+//! [`GuidingCut`]: the learned state of one spatial cell, its construction,
+//! inspection and memory.
+
+use super::config::CutConfig;
+use super::cut_node::{CutNode, Slot};
+use crate::light_tree::LightHierarchy;
+use crate::math::{Side, SumBuffer};
+use alloc::vec;
+use alloc::vec::Vec;
+
+/// One cell's guiding cut: a weighted sub-tree of the global light tree from
+/// its root down to the cut (the paper's Figure 2, right), in two copies.
+///
+/// - The *sampled* copy is `Vec<CutNode>` in depth-first pre-order (a child
+///   always has a larger index than its parent), root first. An empty vector
+///   means the cut ends at the light tree's root: the whole tree is one
+///   cluster (a single-light scene, or `sigma >= 1`).
+/// - The *accumulating* copy is a [`SumBuffer`] with one sum per slot (sum
+///   `2 i + side` for slot `side` of node `i`; a single sum for the root
+///   cluster of an empty cut) and one last sum for the environment light.
+///
+/// A cut is used through the [`GuidingTree`](super::GuidingTree) of its
+/// light tree: [`GuidingTree::new_cut`](super::GuidingTree::new_cut) makes
+/// one, [`GuidingTree::refine`](super::GuidingTree::refine) rebuilds the
+/// sampled copy from the sums and zeroes them. Sampling, pmf and splatting
+/// take `&GuidingCut`; the sums take concurrent adds without locks.
+#[derive(Clone, Debug)]
+pub struct GuidingCut {
+    pub(super) nodes: Vec<CutNode>,
+    pub(super) sums: SumBuffer,
+    /// Learned probability of the environment light among everything the
+    /// cell collected (before the mixture with the prior).
+    pub(super) env_fraction: f32,
+}
+
+/// Why [`GuidingCut::check`] rejected a cut.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CutError {
+    /// A slot points at a cut node that does not exist.
+    IndexOutOfRange {
+        /// The node holding the slot.
+        node: u32,
+    },
+    /// A slot points at a cut node at or before its parent (the nodes are not
+    /// in pre-order, or a node is reached twice).
+    NotPreOrder {
+        /// The node holding the slot.
+        node: u32,
+    },
+    /// A cut node is not reached from the root.
+    Unreachable {
+        /// The node.
+        node: u32,
+    },
+    /// A cut node stands for a light-tree leaf (or a node that does not
+    /// exist), so a root-to-leaf path would end inside the cut.
+    NotInner {
+        /// The node.
+        node: u32,
+    },
+    /// An end slot records another light-tree node than the one it stands
+    /// for.
+    WrongEnd {
+        /// The node holding the slot.
+        node: u32,
+    },
+    /// A learned probability is NaN or outside `[0, 1]`.
+    BadProbability {
+        /// The node.
+        node: u32,
+    },
+    /// The accumulating copy does not have one sum per slot plus one.
+    SumCount,
+    /// The light tree has no root but the cut has nodes.
+    NoTree,
+}
+
+/// Bytes one cell's cut uses, by part.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CutMemory {
+    /// Number of cut nodes in the sampled copy.
+    pub nodes: usize,
+    /// Bytes of the sampled copy's nodes ([`CutNode::BYTES`] each).
+    pub node_bytes: usize,
+    /// Bytes of the accumulating copy's sums.
+    pub sum_bytes: usize,
+    /// Bytes of the [`GuidingCut`] value itself (vector headers, fraction).
+    pub inline_bytes: usize,
+}
+
+impl CutMemory {
+    /// Everything together.
+    pub fn total(&self) -> usize {
+        self.node_bytes + self.sum_bytes + self.inline_bytes
+    }
+}
+
+impl core::ops::AddAssign for CutMemory {
+    fn add_assign(&mut self, o: Self) {
+        self.nodes += o.nodes;
+        self.node_bytes += o.node_bytes;
+        self.sum_bytes += o.sum_bytes;
+        self.inline_bytes += o.inline_bytes;
+    }
+}
+
+impl GuidingCut {
+    /// The initial cut (see [`GuidingTree::new_cut`](super::GuidingTree::new_cut)).
+    pub(crate) fn new<H: LightHierarchy + ?Sized>(tree: &H, config: &CutConfig) -> Self {
+        let config = config.sanitized();
+        let nodes = match tree.root().and_then(|r| tree.children(r)) {
+            Some([l, r]) => {
+                let (el, er) = (tree.energy(l) as f64, tree.energy(r) as f64);
+                let p = crate::math::Descent::probabilities(el, er).map_or(0.5, |(pl, _)| pl);
+                vec![CutNode::new(p as f32, [Slot::End(l), Slot::End(r)])]
+            }
+            None => Vec::new(),
+        };
+        let sums = SumBuffer::new(sum_count(nodes.len()), config.accumulation);
+        Self {
+            nodes,
+            sums,
+            env_fraction: config.environment.unwrap_or(0.0) as f32,
+        }
+    }
+
+    /// The sampled copy's nodes, root first, in pre-order.
+    #[inline]
+    pub fn nodes(&self) -> &[CutNode] {
+        &self.nodes
+    }
+
+    /// The learned fraction of the environment light (before the mixture
+    /// with its prior); 0 when there is no environment light.
+    #[inline]
+    pub fn env_fraction(&self) -> f32 {
+        self.env_fraction
+    }
+
+    /// What has been splatted since the last refinement: the emitters' total
+    /// and the environment's.
+    pub fn accumulated(&self) -> (f64, f64) {
+        let n = self.sums.len();
+        let emitters = (0..n.saturating_sub(1)).map(|i| self.sums.get(i)).sum();
+        (emitters, self.sums.get(n.saturating_sub(1)))
+    }
+
+    /// The light-tree nodes where the cut ends (the clusters), each with the
+    /// learned probability of reaching it through the cut, left to right.
+    /// An empty cut gives the root with probability 1.
+    pub fn clusters<H: LightHierarchy + ?Sized>(&self, tree: &H) -> Vec<(u32, f64)> {
+        let mut out = Vec::new();
+        let Some(root) = tree.root() else {
+            return out;
+        };
+        if self.nodes.is_empty() {
+            out.push((root, 1.0));
+            return out;
+        }
+        // (cut node, light node, probability); right pushed first.
+        let mut stack = vec![(0u32, root, 1.0f64)];
+        while let Some((i, light, p)) = stack.pop() {
+            let (Some(node), Some(children)) = (self.nodes.get(i as usize), tree.children(light))
+            else {
+                continue;
+            };
+            let (pl, pr) = node.probabilities();
+            for side in [Side::Right, Side::Left] {
+                let q = p * if side == Side::Left { pl } else { pr };
+                let c = children[side.index()];
+                match node.child(side) {
+                    Some(j) => stack.push((j, c, q)),
+                    None => out.push((c, q)),
+                }
+            }
+        }
+        out
+    }
+
+    /// Checks that the cut is a valid cut of `tree`: every cut node is
+    /// reached exactly once from the root, in pre-order, stands for an
+    /// inner light-tree node, end slots record the right light node, the
+    /// probabilities lie in `[0, 1]` and there is one sum per slot plus one.
+    /// Then each root-to-leaf path of the light tree crosses exactly one
+    /// slot that ends the cut.
+    pub fn check<H: LightHierarchy + ?Sized>(&self, tree: &H) -> Result<(), CutError> {
+        if self.sums.len() != sum_count(self.nodes.len()) {
+            return Err(CutError::SumCount);
+        }
+        if self.nodes.is_empty() {
+            return Ok(());
+        }
+        let root = tree.root().ok_or(CutError::NoTree)?;
+        let mut seen = vec![false; self.nodes.len()];
+        let mut stack = vec![(0u32, root)];
+        while let Some((i, light)) = stack.pop() {
+            let node = &self.nodes[i as usize];
+            if seen[i as usize] {
+                return Err(CutError::NotPreOrder { node: i });
+            }
+            seen[i as usize] = true;
+            let children = tree.children(light).ok_or(CutError::NotInner { node: i })?;
+            let p = node.p_left();
+            if !(0.0..=1.0).contains(&p) {
+                return Err(CutError::BadProbability { node: i });
+            }
+            for side in [Side::Left, Side::Right] {
+                let c = children[side.index()];
+                match node.slot(side) {
+                    Slot::Child(j) => {
+                        if j as usize >= self.nodes.len() {
+                            return Err(CutError::IndexOutOfRange { node: i });
+                        }
+                        if j <= i {
+                            return Err(CutError::NotPreOrder { node: i });
+                        }
+                        stack.push((j, c));
+                    }
+                    Slot::End(n) => {
+                        if c < 1 << 31 && n != c {
+                            return Err(CutError::WrongEnd { node: i });
+                        }
+                    }
+                }
+            }
+        }
+        match seen.iter().position(|s| !s) {
+            Some(i) => Err(CutError::Unreachable { node: i as u32 }),
+            None => Ok(()),
+        }
+    }
+
+    /// Bytes this cut uses, by part (counted on lengths).
+    pub fn memory(&self) -> CutMemory {
+        CutMemory {
+            nodes: self.nodes.len(),
+            node_bytes: self.nodes.len() * CutNode::BYTES,
+            sum_bytes: self.sums.bytes(),
+            inline_bytes: core::mem::size_of::<Self>(),
+        }
+    }
+
+    /// Heap bytes (nodes and sums), without the value itself.
+    pub fn heap_bytes(&self) -> usize {
+        self.nodes.len() * CutNode::BYTES + self.sums.bytes()
+    }
+
+    /// Index of the environment light's sum.
+    #[inline]
+    pub(super) fn env_sum(&self) -> usize {
+        sum_count(self.nodes.len()) - 1
+    }
+}
+
+/// Sums for a cut of `nodes` nodes: one per slot (one for the root cluster
+/// of an empty cut) plus the environment's.
+#[inline]
+pub(super) fn sum_count(nodes: usize) -> usize {
+    (2 * nodes).max(1) + 1
+}

@@ -1,0 +1,311 @@
+//! [`Glt`]: the Guiding Light Tree over its own spatial tree, for renderers
+//! without directional guiding. One [`GuidingCut`] per cell of PPG's spatial
+//! binary tree; it is itself a [`LightSampler`].
+
+use super::config::CutConfig;
+use super::cut::{CutMemory, GuidingCut};
+use super::cut_node::CutNode;
+use super::guiding_tree::GuidingTree;
+use super::splat::SplatOutcome;
+use crate::emitter::ShadingContext;
+use crate::light_sampler::{LightId, LightSample, LightSampler};
+use crate::light_tree::LightHierarchy;
+use crate::math::Aabb;
+use crate::math::pmf_to_f32;
+use crate::math::scalar::sqrt64;
+use crate::spatial::{BinaryTree, CellId, SpatialError, SpatialTree};
+use core::sync::atomic::{AtomicU64, Ordering::Relaxed};
+use glam::Vec3;
+
+/// Parameters of a [`Glt`]: the cuts' and the spatial tree's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GltConfig {
+    /// How each cell's cut is refined and sampled.
+    pub cut: CutConfig,
+    /// PPG's spatial threshold `c`: after iteration `k` (counted from 0) a
+    /// cell splits while its number of splats exceeds `c * sqrt(2^k)`; each
+    /// split halves the count and gives both halves a copy of the cut and
+    /// its statistics. Default 12000 (PPG's).
+    pub spatial_threshold: f64,
+    /// Cap, in bytes, on spatial tree plus cuts when splitting cells (the
+    /// cuts are charged at their size before the split); `None` for none.
+    pub spatial_budget: Option<usize>,
+}
+
+impl Default for GltConfig {
+    fn default() -> Self {
+        Self {
+            cut: CutConfig::default(),
+            spatial_threshold: 12000.0,
+            spatial_budget: None,
+        }
+    }
+}
+
+/// What a cell of a [`Glt`] holds: its cut and the number of splats it
+/// received this iteration (for spatial refinement).
+#[derive(Debug)]
+pub struct GltCell {
+    cut: GuidingCut,
+    splats: AtomicU64,
+}
+
+impl Clone for GltCell {
+    fn clone(&self) -> Self {
+        Self {
+            cut: self.cut.clone(),
+            splats: AtomicU64::new(self.splats.load(Relaxed)),
+        }
+    }
+}
+
+impl GltCell {
+    /// The cell's cut.
+    #[inline]
+    pub fn cut(&self) -> &GuidingCut {
+        &self.cut
+    }
+
+    /// Splats (zero values included) received since the last refinement.
+    #[inline]
+    pub fn splats(&self) -> u64 {
+        self.splats.load(Relaxed)
+    }
+}
+
+/// Bytes a [`Glt`] uses, by part.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GltMemory {
+    /// Number of cells.
+    pub cells: usize,
+    /// The cuts together (nodes, sums, inline parts of the cells' cuts).
+    pub cuts: CutMemory,
+    /// The spatial tree's own storage: node words, per-cell bookkeeping and
+    /// the inline [`GltCell`] values (which include the cuts' inline parts,
+    /// so those are not added twice in [`GltMemory::total`]).
+    pub spatial_bytes: usize,
+    /// The [`GuidingTree`]'s split table, shared by all cells (4 bytes per
+    /// light-tree node).
+    pub shared_bytes: usize,
+}
+
+impl GltMemory {
+    /// Bytes of one cut node.
+    pub const BYTES_PER_CUT_NODE: usize = CutNode::BYTES;
+
+    /// Everything together.
+    pub fn total(&self) -> usize {
+        self.spatial_bytes + self.shared_bytes + self.cuts.node_bytes + self.cuts.sum_bytes
+    }
+
+    /// Average bytes per cell (cut nodes, sums and spatial share; the
+    /// shared table excluded).
+    pub fn bytes_per_cell(&self) -> f64 {
+        (self.total() - self.shared_bytes) as f64 / self.cells.max(1) as f64
+    }
+}
+
+/// The Guiding Light Tree over its own spatial tree: one learned cut per
+/// cell of PPG's binary tree over the scene, sampled by the GLT's sampling
+/// rule (see `sampling.rs` and [`GuidingCut`]).
+///
+/// Per iteration a renderer samples lights with [`LightSampler::sample`]
+/// (any number of threads), splats the resulting direct-light estimates
+/// with [`Glt::splat`] (idem), then calls [`Glt::refine`] once.
+#[derive(Debug)]
+pub struct Glt<'a, H: LightHierarchy + ?Sized> {
+    guide: GuidingTree<'a, H>,
+    config: GltConfig,
+    spatial: BinaryTree<GltCell>,
+    iteration: u32,
+    dropped: AtomicU64,
+}
+
+impl<'a, H: LightHierarchy + ?Sized> Glt<'a, H> {
+    /// A GLT over the light hierarchy `tree` for shading points inside
+    /// `scene` (the scene's geometry bounds; points outside are clamped
+    /// onto the spatial tree's cube). One cell with the initial (energy
+    /// prior) cut. Errors for empty or non-finite `scene`.
+    pub fn new(tree: &'a H, scene: Aabb, config: GltConfig) -> Result<Self, SpatialError> {
+        let mut config = config;
+        config.cut = config.cut.sanitized();
+        if config.spatial_threshold.is_nan() || config.spatial_threshold < 0.0 {
+            config.spatial_threshold = GltConfig::default().spatial_threshold;
+        }
+        let guide = GuidingTree::new(tree, config.cut);
+        let cell = GltCell {
+            cut: guide.new_cut(),
+            splats: AtomicU64::new(0),
+        };
+        Ok(Self {
+            guide,
+            config,
+            spatial: BinaryTree::new(scene, cell)?,
+            iteration: 0,
+            dropped: AtomicU64::new(0),
+        })
+    }
+
+    /// The light hierarchy.
+    pub fn tree(&self) -> &'a H {
+        self.guide.tree()
+    }
+
+    /// The guiding tree every cell's cut is used through.
+    pub fn guiding_tree(&self) -> &GuidingTree<'a, H> {
+        &self.guide
+    }
+
+    /// The configuration (sanitized).
+    pub fn config(&self) -> &GltConfig {
+        &self.config
+    }
+
+    /// The spatial tree and its cells.
+    pub fn spatial(&self) -> &BinaryTree<GltCell> {
+        &self.spatial
+    }
+
+    /// Refinements done so far.
+    pub fn iteration(&self) -> u32 {
+        self.iteration
+    }
+
+    /// The cut of the cell holding `p` (`None` for a non-finite point).
+    #[inline]
+    pub fn cut_at(&self, p: Vec3) -> Option<&GuidingCut> {
+        let cell = self.spatial.locate(p)?;
+        Some(&self.spatial.data(cell).cut)
+    }
+
+    /// Splats dropped as bad input since creation: non-finite or negative
+    /// values or positions, emitters out of range or with zero power, the
+    /// environment when none is configured.
+    pub fn dropped_splats(&self) -> u64 {
+        self.dropped.load(Relaxed)
+    }
+
+    /// Chooses a light at `ctx` from an `f64` number (53 bits), with the
+    /// unrounded pmf: equal bit for bit to [`Glt::pmf_exact`].
+    pub fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
+        self.guide.sample_exact(self.cut_at(ctx.position)?, ctx, u)
+    }
+
+    /// The unrounded pmf of `light` at `ctx`.
+    pub fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
+        match self.cut_at(ctx.position) {
+            Some(cut) => self.guide.pmf_exact(cut, ctx, light),
+            None => 0.0,
+        }
+    }
+
+    /// Records a direct-light estimate `value` for `light` seen from `p` (see
+    /// [`GuidingTree::splat`] for what the value is). `p` is first jittered
+    /// uniformly inside a box the size of its cell centred on it (PPG's
+    /// stochastic box filter, +-1/2 cell per axis; the paper's code uses
+    /// +-1/4), which spreads each sample over the neighbouring cells in
+    /// proportion to their overlap with that box, so adjacent cells learn
+    /// similar cuts and no seams appear at cell borders. One `next_u64` of
+    /// `rng` per call. `&self`: any number of threads at once.
+    pub fn splat<R: rand_core::Rng + ?Sized>(
+        &self,
+        p: Vec3,
+        light: LightId,
+        value: f32,
+        rng: &mut R,
+    ) -> SplatOutcome {
+        let Some((_, bounds)) = self.spatial.locate_with_bounds(p) else {
+            return self.reject();
+        };
+        let bits = rng.next_u64();
+        let unit = |k: u32| ((bits >> (k * 21)) & 0x1f_ffff) as f32 * (1.0 / 2_097_152.0) - 0.5;
+        let jitter = Vec3::new(unit(0), unit(1), unit(2)) * bounds.diagonal();
+        self.splat_at(p + jitter, light, value)
+    }
+
+    /// Like [`Glt::splat`] without jitter: the estimate goes to the cell
+    /// holding `p` (deterministic; nearest-cell filtering).
+    pub fn splat_at(&self, p: Vec3, light: LightId, value: f32) -> SplatOutcome {
+        let Some(cell) = self.spatial.locate(p) else {
+            return self.reject();
+        };
+        let cell = self.spatial.data(cell);
+        let outcome = self.guide.splat(&cell.cut, light, value);
+        match outcome {
+            SplatOutcome::Dropped => return self.reject(),
+            SplatOutcome::Recorded | SplatOutcome::Zero => {
+                cell.splats.fetch_add(1, Relaxed);
+            }
+        }
+        outcome
+    }
+
+    #[inline]
+    fn reject(&self) -> SplatOutcome {
+        self.dropped.fetch_add(1, Relaxed);
+        SplatOutcome::Dropped
+    }
+
+    /// Ends an iteration: splits cells that received more than
+    /// `c * sqrt(2^k)` splats (both halves get a copy of the cut and its
+    /// sums), refines every cut from its sums (a cell that collected nothing
+    /// keeps its cut) and zeroes the sums and counts.
+    pub fn refine(&mut self) {
+        // c * sqrt(2^k); 2^k by doubling (no `powi` without std), infinite
+        // (no more splits) past f64's range.
+        let two_k = (0..self.iteration.min(1100)).fold(1.0f64, |x, _| x * 2.0);
+        let threshold = self.config.spatial_threshold * sqrt64(two_k);
+        self.spatial.refine_with_heap(
+            |cell, _| cell.splats.load(Relaxed) as f64 > threshold,
+            |cell| {
+                let half = *cell.splats.get_mut() / 2;
+                *cell.splats.get_mut() = half;
+                cell.clone()
+            },
+            |cell| cell.cut.heap_bytes(),
+            self.config.spatial_budget,
+        );
+        for cell in self.spatial.data_slice_mut() {
+            self.guide.refine(&mut cell.cut);
+            *cell.splats.get_mut() = 0;
+        }
+        self.iteration = self.iteration.saturating_add(1);
+    }
+
+    /// Bytes used, by part.
+    pub fn memory(&self) -> GltMemory {
+        let mut cuts = CutMemory::default();
+        for cell in self.spatial.data_slice() {
+            cuts += cell.cut.memory();
+        }
+        GltMemory {
+            cells: self.spatial.cell_count(),
+            cuts,
+            spatial_bytes: self.spatial.bytes(),
+            shared_bytes: self.guide.bytes(),
+        }
+    }
+
+    /// The cell holding `p`, `None` for a non-finite point.
+    pub fn locate(&self, p: Vec3) -> Option<CellId> {
+        self.spatial.locate(p)
+    }
+}
+
+impl<H: LightHierarchy + ?Sized> LightSampler for Glt<'_, H> {
+    /// Locates the cell of `ctx.position`, then applies the GLT's sampling
+    /// rule with its cut. `None` for a non-finite position.
+    #[inline]
+    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+        self.guide.sample(self.cut_at(ctx.position)?, ctx, u)
+    }
+
+    #[inline]
+    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        pmf_to_f32(self.pmf_exact(ctx, light))
+    }
+
+    fn is_empty(&self) -> bool {
+        self.guide.is_empty()
+    }
+}

@@ -1,0 +1,136 @@
+//! [`GuidingTree`]: what every cell's cut shares: the light tree, its energy
+//! prior precomputed per inner node, and the configuration.
+
+use super::config::CutConfig;
+use super::cut::GuidingCut;
+use crate::light_tree::LightHierarchy;
+use crate::math::Descent;
+use alloc::vec::Vec;
+
+/// The global light tree prepared for guiding: the hierarchy, each inner
+/// node's energy split precomputed (4 bytes per node) and the cut
+/// configuration. One per scene; every cell's [`GuidingCut`] is sampled
+/// ([`GuidingTree::sample`]), splatted ([`GuidingTree::splat`]) and refined
+/// ([`GuidingTree::refine`]) through it.
+///
+/// The split table is why the GLT's walk is cheaper per level than a plain
+/// energy descent: the prior probabilities of a node's children come from
+/// one 4-byte load instead of two 32-byte node loads (the right child lies
+/// far from its parent in memory) and a division. Each entry stores the
+/// probability of the *smaller* side in `f32`, its sign telling which side
+/// that is, so both sides keep 24 bits of relative precision: a child with
+/// 1e-9 of its parent's energy keeps its 1e-9 (a plain `f32` `p_left` would
+/// round the pair to 1 and 0 and lose the child's prior floor). A child with
+/// any positive energy gets a positive probability (at least the smallest
+/// `f32`); both children dark is NaN (neither can be chosen).
+#[derive(Clone, Debug)]
+pub struct GuidingTree<'a, H: LightHierarchy + ?Sized> {
+    tree: &'a H,
+    split: Vec<f32>,
+    config: CutConfig,
+    has_energy: bool,
+}
+
+/// Encodes the split of a node with child energies `el`, `er`.
+fn encode_split(el: f32, er: f32) -> f32 {
+    let (l, r) = (el as f64, er as f64);
+    let Some((pl, pr)) = Descent::probabilities(l, r) else {
+        return f32::NAN;
+    };
+    let tiny = f32::from_bits(1);
+    if pl <= pr {
+        let q = pl as f32;
+        if l > 0.0 { q.max(tiny) } else { 0.0 }
+    } else {
+        let q = pr as f32;
+        -(if r > 0.0 { q.max(tiny) } else { 0.0 })
+    }
+}
+
+/// Decodes a split entry into `(p_left, p_right)`; `None` for a dark node.
+///
+/// Branch-free in the sign: which side is the smaller one is a coin flip
+/// per level, and a mispredicted branch there would cost more than the
+/// rest of the level.
+#[inline(always)]
+pub(crate) fn decode_split(s: f32) -> Option<(f64, f64)> {
+    if s.is_nan() {
+        return None;
+    }
+    let small = s.abs() as f64;
+    let large = 1.0 - small;
+    // All ones when the right side is the smaller one (sign bit set).
+    let mask = ((s.to_bits() >> 31) as u64).wrapping_neg();
+    let (a, b) = (small.to_bits(), large.to_bits());
+    let left = f64::from_bits((a & !mask) | (b & mask));
+    let right = f64::from_bits((b & !mask) | (a & mask));
+    Some((left, right))
+}
+
+impl<'a, H: LightHierarchy + ?Sized> GuidingTree<'a, H> {
+    /// Prepares `tree` for guiding with `config` (sanitized, see
+    /// [`CutConfig::sanitized`]). O(nodes).
+    pub fn new(tree: &'a H, config: CutConfig) -> Self {
+        let split = (0..tree.node_count() as u32)
+            .map(|n| match tree.children(n) {
+                Some([l, r]) => encode_split(tree.energy(l), tree.energy(r)),
+                None => f32::NAN,
+            })
+            .collect();
+        Self {
+            tree,
+            split,
+            config: config.sanitized(),
+            has_energy: tree.root().is_some_and(|r| tree.energy(r) > 0.0),
+        }
+    }
+
+    /// The light hierarchy.
+    #[inline]
+    pub fn tree(&self) -> &'a H {
+        self.tree
+    }
+
+    /// The (sanitized) configuration.
+    #[inline]
+    pub fn config(&self) -> &CutConfig {
+        &self.config
+    }
+
+    /// True when some emitter has positive power.
+    #[inline]
+    pub fn has_energy(&self) -> bool {
+        self.has_energy
+    }
+
+    /// Heap bytes of the split table (4 per light-tree node).
+    pub fn bytes(&self) -> usize {
+        self.split.len() * core::mem::size_of::<f32>()
+    }
+
+    /// The prior (energy) probabilities of the children of inner node
+    /// `node`: the light tree's `E(l) / (E(l) + E(r))` and its complement,
+    /// to `f32` relative precision on each side. `None` when both children
+    /// are dark or `node` is not an inner node.
+    #[inline(always)]
+    pub fn prior_split(&self, node: u32) -> Option<(f64, f64)> {
+        decode_split(*self.split.get(node as usize)?)
+    }
+
+    /// The raw split-table entry of `node` (NaN for leaves and indices out
+    /// of range); [`decode_split`] turns it into probabilities.
+    #[inline(always)]
+    pub(crate) fn raw_split(&self, node: u32) -> f32 {
+        self.split.get(node as usize).copied().unwrap_or(f32::NAN)
+    }
+
+    /// The initial cut of a cell: the light tree's root split by energy,
+    /// `p_left = E(left) / (E(left) + E(right))` (the paper's code starts at
+    /// 0.5/0.5 whatever the power), so sampling it is exactly
+    /// tree-by-energy sampling. A tree whose root is a leaf (or that is
+    /// empty) gets the empty cut. The environment fraction starts at its
+    /// prior.
+    pub fn new_cut(&self) -> GuidingCut {
+        GuidingCut::new(self.tree, &self.config)
+    }
+}

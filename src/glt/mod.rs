@@ -1,0 +1,44 @@
+//! The Guiding Light Tree (Hamann, Jung and Dachsbacher, EGSR 2023): learned
+//! adaptive cuts through the global light tree, one per spatial cell, that
+//! guide next-event estimation.
+//!
+//! Where to find what:
+//! - [`GuidingTree`] (`guiding_tree.rs`): what all cells share, the light
+//!   tree with its energy prior precomputed and the [`CutConfig`]; every
+//!   operation on a cut goes through it;
+//! - [`GuidingCut`] (`cut.rs`): one cell's learned state, a weighted sub-tree
+//!   of the light tree from its root down to the cut, in two copies (sampled
+//!   [`CutNode`]s, accumulating sums);
+//! - `cut_node.rs`: the 12-byte [`CutNode`] and its [`Slot`]s;
+//! - `sampling.rs`: **the GLT's sampling rule** and its pmf (cut, then the
+//!   light tree, mixed with the energy prior and the environment light);
+//! - `splat.rs`: recording direct-light estimates ([`GuidingTree::splat`]);
+//! - `refine.rs`: rebuilding the cut from its sums ([`GuidingTree::refine`]);
+//! - `config.rs`: [`CutConfig`], [`BelowCut`], [`SplitPrior`];
+//! - `field.rs`: [`Glt`], one cut per cell of its own spatial tree, a
+//!   [`crate::LightSampler`].
+//!
+//! How it differs from the paper's code (see the crate's reference notes):
+//! the initial cut is the energy prior, not 0.5/0.5; a defensive mixture
+//! with the energy prior (`alpha`, default 0.2) keeps every emitter with
+//! power at a non-zero pmf, so delta lights stay unbiased without MIS;
+//! cut nodes take 12 bytes, not 20; sums accumulate in `f64` or exactly,
+//! never in `f32`; the one-number descent is exact at any depth; paths have
+//! no 32-level limit; single-light and empty scenes work.
+
+mod config;
+mod cut;
+mod cut_node;
+mod field;
+mod guiding_tree;
+mod refine;
+mod sampling;
+mod splat;
+
+pub use config::{BelowCut, CutConfig, SplitPrior};
+pub use cut::{CutError, CutMemory, GuidingCut};
+pub use cut_node::{CutNode, Slot};
+pub use field::{Glt, GltCell, GltConfig, GltMemory};
+pub use guiding_tree::GuidingTree;
+pub use sampling::CutSampler;
+pub use splat::SplatOutcome;

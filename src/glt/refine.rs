@@ -1,0 +1,166 @@
+//! Rebuilding a cut from what it collected: split where a slot's share is
+//! above `sigma`, end (merge) where it is not.
+
+use super::config::{CutConfig, SplitPrior};
+use super::cut::{GuidingCut, sum_count};
+use super::cut_node::{CutNode, Slot};
+use super::guiding_tree::GuidingTree;
+use crate::light_tree::LightHierarchy;
+use crate::math::Side;
+use alloc::vec;
+use alloc::vec::Vec;
+
+/// No parent: the task is the root.
+const ROOT: u32 = u32::MAX;
+
+/// A slot still to decide: where it hangs, the light node it stands for, its
+/// weight and the old cut node that stood for the same light node (if any).
+struct Task {
+    parent: u32,
+    side: Side,
+    light: u32,
+    weight: f64,
+    old: Option<u32>,
+}
+
+impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
+    /// Rebuilds `cut`'s sampled copy from the accumulated sums, then zeroes them
+    /// (swapping the two copies). Returns false when the cell collected
+    /// nothing from emitters: then the cut is kept as it was.
+    ///
+    /// Top-down from the root with the cell's total `T`: a slot whose weight
+    /// is above `sigma * T` and whose light node is not a leaf becomes a cut
+    /// node. A node that existed before takes its children's weights from
+    /// their sums; a slot split for the first time shares its weight by the
+    /// [`SplitPrior`], and its children are examined in the same pass, so
+    /// one pass may split several levels. A slot at or below `sigma * T`
+    /// ends the cut, which merges any old subtree under it. The new
+    /// `p_left = w_left / (w_left + w_right)` (weights in `f64`, stored as
+    /// `f32`). The environment fraction becomes `env / (env + T)`.
+    pub fn refine(&self, cut: &mut GuidingCut) -> bool {
+        let config = self.config();
+        let n = cut.nodes.len();
+        let clusters = sum_count(n) - 1;
+        let sums: Vec<f64> = (0..clusters).map(|i| cut.sums.get(i)).collect();
+        let env = cut.sums.get(clusters);
+        let total: f64 = sums.iter().sum();
+        if config.environment.is_some() && env + total > 0.0 {
+            cut.env_fraction = (env / (env + total)) as f32;
+        }
+        let rebuilt = total > 0.0 && total.is_finite();
+        if rebuilt {
+            cut.nodes = rebuild(self.tree(), &cut.nodes, &sums, total, config);
+        }
+        cut.sums.reset(sum_count(cut.nodes.len()));
+        rebuilt
+    }
+}
+
+/// Weight of each old cut node's subtree (children follow parents, so one
+/// backward pass suffices).
+fn subtree_weights(nodes: &[CutNode], sums: &[f64]) -> Vec<f64> {
+    let mut w = vec![0.0f64; nodes.len()];
+    for i in (0..nodes.len()).rev() {
+        let mut t = 0.0;
+        for side in [Side::Left, Side::Right] {
+            t += match nodes[i].child(side) {
+                Some(j) => w.get(j as usize).copied().unwrap_or(0.0),
+                None => sums.get(2 * i + side.index()).copied().unwrap_or(0.0),
+            };
+        }
+        w[i] = t;
+    }
+    w
+}
+
+/// A fresh split's child weights. A dark child (zero energy) gets nothing.
+fn split_weight<H: LightHierarchy + ?Sized>(
+    tree: &H,
+    [l, r]: [u32; 2],
+    weight: f64,
+    prior: SplitPrior,
+) -> (f64, f64) {
+    let (el, er) = (tree.energy(l) as f64, tree.energy(r) as f64);
+    let (el, er) = (el.max(0.0), er.max(0.0));
+    if !(el > 0.0 || er > 0.0) {
+        return (0.0, 0.0);
+    }
+    match prior {
+        SplitPrior::Half => match (el > 0.0, er > 0.0) {
+            (true, true) => (weight * 0.5, weight * 0.5),
+            (true, false) => (weight, 0.0),
+            _ => (0.0, weight),
+        },
+        SplitPrior::Energy => {
+            let t = el + er;
+            (weight * (el / t), weight * (er / t))
+        }
+    }
+}
+
+fn rebuild<H: LightHierarchy + ?Sized>(
+    tree: &H,
+    old: &[CutNode],
+    sums: &[f64],
+    total: f64,
+    config: &CutConfig,
+) -> Vec<CutNode> {
+    let Some(root) = tree.root() else {
+        return Vec::new();
+    };
+    let threshold = config.sigma * total;
+    let old_weights = subtree_weights(old, sums);
+    let mut nodes: Vec<CutNode> = Vec::new();
+    let mut stack = vec![Task {
+        parent: ROOT,
+        side: Side::Left,
+        light: root,
+        weight: total,
+        old: (!old.is_empty()).then_some(0),
+    }];
+    while let Some(t) = stack.pop() {
+        let mut slot = Slot::End(t.light);
+        if let Some(children) = tree.children(t.light).filter(|_| t.weight > threshold) {
+            // Each side's weight and the old node that stands for it.
+            let sides: [(f64, Option<u32>); 2] = match t.old.and_then(|i| old.get(i as usize)) {
+                Some(o) => {
+                    let i = t.old.unwrap_or(0) as usize;
+                    [Side::Left, Side::Right].map(|s| match o.child(s) {
+                        Some(j) => (old_weights.get(j as usize).copied().unwrap_or(0.0), Some(j)),
+                        None => (sums.get(2 * i + s.index()).copied().unwrap_or(0.0), None),
+                    })
+                }
+                None => {
+                    let (wl, wr) = split_weight(tree, children, t.weight, config.split_prior);
+                    [(wl, None), (wr, None)]
+                }
+            };
+            let sum = sides[0].0 + sides[1].0;
+            if sum > 0.0 {
+                let index = nodes.len() as u32;
+                let p_left = (sides[0].0 / sum) as f32;
+                nodes.push(CutNode::new(
+                    p_left,
+                    [Slot::End(children[0]), Slot::End(children[1])],
+                ));
+                // Right first so the left subtree is numbered first
+                // (pre-order).
+                for side in [Side::Right, Side::Left] {
+                    let (weight, old) = sides[side.index()];
+                    stack.push(Task {
+                        parent: index,
+                        side,
+                        light: children[side.index()],
+                        weight,
+                        old,
+                    });
+                }
+                slot = Slot::Child(index);
+            }
+        }
+        if t.parent != ROOT {
+            nodes[t.parent as usize].set_slot(t.side, slot);
+        }
+    }
+    nodes
+}

@@ -1,0 +1,396 @@
+//! The GLT's sampling rule and its pmf.
+//!
+//! For a shading point in a cell with cut `C`, emitter `l` is chosen with
+//!
+//! ```text
+//! pmf(l)   = (1 - alpha) (1 - f) P_cut(l) + alpha (1 - q) P_prior(l)
+//! pmf(env) = (1 - alpha) f + alpha q
+//! ```
+//!
+//! where `f` is the cell's learned environment fraction, `q` the user's
+//! prior probability of the environment (both 0 without one), `P_prior` the
+//! tree-by-energy pmf from the light tree's root, and `P_cut` the product of
+//! the cut's learned `p_left`/`1 - p_left` down to the slot that ends the cut,
+//! then of the light tree's energy ratios (the paper) or importance ratios
+//! ([`BelowCut::Importance`]) below it.
+//!
+//! One uniform number drives everything through one [`Descent`]: first
+//! environment or emitters, then which mixture component, then the walk
+//! from the light tree's root to a leaf under the chosen component's
+//! probabilities. Along that one walk both products (`P_cut` and `P_prior`)
+//! are tracked, so the mixture pmf of the chosen emitter is known without a
+//! second walk. [`Rule::step`] computes the probabilities at a node and
+//! [`Rule::apply`] multiplies them in; the pmf evaluation replays exactly
+//! these two functions along the emitter's path, so the pmf `sample` returns
+//! equals [`GuidingTree::pmf_exact`] bit for bit, fallbacks included.
+
+use super::config::{BelowCut, CutConfig};
+use super::cut::GuidingCut;
+use super::cut_node::CutNode;
+use super::guiding_tree::{GuidingTree, decode_split};
+use crate::emitter::ShadingContext;
+use crate::light_sampler::{LightId, LightSample, LightSampler};
+use crate::light_tree::LightHierarchy;
+use crate::math::{Descent, Side, pmf_to_f32};
+
+/// The probabilities of the top-level choices in one cell.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Mixture {
+    /// Probability of the environment light.
+    pub(crate) env: f64,
+    /// Weight of the learned component (`(1 - alpha)(1 - f)`).
+    pub(crate) cut: f64,
+    /// Weight of the prior component (`alpha (1 - q)`).
+    pub(crate) prior: f64,
+}
+
+impl Mixture {
+    /// The mixture for `cut` under a sanitized `config`. Emitters get
+    /// nothing when the light tree has no energy at all (then the
+    /// environment, if any, gets everything).
+    #[inline]
+    pub(crate) fn new(emitters: bool, cut: &GuidingCut, config: &CutConfig) -> Self {
+        let a = config.alpha;
+        match (config.environment, emitters) {
+            (None, false) => Self {
+                env: 0.0,
+                cut: 0.0,
+                prior: 0.0,
+            },
+            (Some(_), false) => Self {
+                env: 1.0,
+                cut: 0.0,
+                prior: 0.0,
+            },
+            (None, true) => Self {
+                env: 0.0,
+                cut: 1.0 - a,
+                prior: a,
+            },
+            (Some(q), true) => {
+                let f = (cut.env_fraction as f64).clamp(0.0, 1.0);
+                Self {
+                    env: (1.0 - a) * f + a * q,
+                    cut: (1.0 - a) * (1.0 - f),
+                    prior: a * (1.0 - q),
+                }
+            }
+        }
+    }
+
+    /// The pmf of an emitter from its two products. Sampling and
+    /// evaluation both end here.
+    #[inline]
+    fn emitter_pmf(&self, p: Products) -> f64 {
+        self.cut * p.cut + self.prior * p.prior
+    }
+}
+
+/// Where a walk is: an inner light-tree node and, while inside the cut, the
+/// cut node that stands for it.
+#[derive(Clone, Copy, Debug)]
+struct Cursor {
+    light: u32,
+    cut: Option<u32>,
+}
+
+/// The probabilities at one inner light-tree node.
+#[derive(Clone, Copy, Debug)]
+struct Step {
+    /// Learned component: the cut's `p_left` inside the cut, the below-cut
+    /// rule under it. `None` where neither side can be chosen.
+    cut: Option<(f64, f64)>,
+    /// Prior component: energy ratios (`None` when not tracked or both
+    /// children are dark).
+    prior: Option<(f64, f64)>,
+    /// The cut node on each side, `None` where the cut ends.
+    next: [Option<u32>; 2],
+}
+
+/// Running products of the two components along a walk.
+#[derive(Clone, Copy, Debug)]
+struct Products {
+    cut: f64,
+    prior: f64,
+}
+
+/// The probability of `side` in a pair.
+#[inline]
+fn pick((pl, pr): (f64, f64), side: Side) -> f64 {
+    match side {
+        Side::Left => pl,
+        Side::Right => pr,
+    }
+}
+
+/// Everything one query needs: the guiding tree, the cell's cut nodes, the
+/// rule below the cut and the shading point.
+pub(crate) struct Rule<'a, 'b, H: LightHierarchy + ?Sized> {
+    guide: &'b GuidingTree<'a, H>,
+    tree: &'a H,
+    nodes: &'b [CutNode],
+    below: BelowCut,
+    ctx: &'b ShadingContext,
+    /// Whether the prior component has weight (else its product is not
+    /// tracked and stays 1, multiplied by a zero weight).
+    prior: bool,
+    mixture: Mixture,
+}
+
+impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
+    /// The rule for `cut` at `ctx`.
+    #[inline]
+    pub(crate) fn new(
+        guide: &'b GuidingTree<'a, H>,
+        cut: &'b GuidingCut,
+        ctx: &'b ShadingContext,
+    ) -> Self {
+        let config = guide.config();
+        let mixture = Mixture::new(guide.has_energy(), cut, config);
+        Self {
+            guide,
+            tree: guide.tree(),
+            nodes: &cut.nodes,
+            below: config.below_cut,
+            ctx,
+            prior: mixture.prior > 0.0,
+            mixture,
+        }
+    }
+
+    #[inline(always)]
+    fn root(&self) -> Option<Cursor> {
+        Some(Cursor {
+            light: self.tree.root()?,
+            cut: (!self.nodes.is_empty()).then_some(0),
+        })
+    }
+
+    /// The importance probabilities of the children of inner node `node`.
+    #[inline(always)]
+    fn importance(&self, node: u32) -> Option<(f64, f64)> {
+        let [l, r] = self.tree.children(node)?;
+        let imp = |n| crate::light_sampler::importance(self.ctx, &self.tree.node_bounds(n)) as f64;
+        Descent::probabilities(imp(l), imp(r))
+    }
+
+    /// The probabilities of both components at the inner node `at`, whose
+    /// entry in the guiding tree's split table is `split`.
+    #[inline(always)]
+    fn step(&self, at: Cursor, split: f32) -> Step {
+        match at.cut.and_then(|i| self.nodes.get(i as usize)) {
+            Some(node) => Step {
+                cut: Some(node.probabilities()),
+                prior: if self.prior {
+                    decode_split(split)
+                } else {
+                    None
+                },
+                next: [node.child(Side::Left), node.child(Side::Right)],
+            },
+            None => {
+                let e = decode_split(split);
+                let cut = match self.below {
+                    BelowCut::Energy => e,
+                    // Both importances zero: fall back to energy, so the
+                    // component stays a distribution.
+                    BelowCut::Importance => self.importance(at.light).or(e),
+                };
+                Step {
+                    cut,
+                    prior: e,
+                    next: [None, None],
+                }
+            }
+        }
+    }
+
+    /// Multiplies the probabilities of `side` at `step` into `p`.
+    #[inline(always)]
+    fn apply(&self, p: &mut Products, step: &Step, side: Side) {
+        p.cut = match step.cut {
+            Some(pair) => p.cut * pick(pair, side),
+            None => 0.0,
+        };
+        if self.prior {
+            p.prior = match step.prior {
+                Some(pair) => p.prior * pick(pair, side),
+                None => 0.0,
+            };
+        }
+    }
+
+    /// Samples a light with the descent `d`; the light and its `f64` pmf.
+    pub(crate) fn sample(&self, mut d: Descent) -> Option<(LightId, f64)> {
+        let m = self.mixture;
+        if m.env > 0.0 {
+            let (pe, pt) = Descent::probabilities(m.env, m.cut + m.prior)?;
+            if d.choose_with(pe, pt) == Side::Left {
+                return Some((LightId::Environment, m.env));
+            }
+        }
+        let use_cut = match (m.cut > 0.0, self.prior) {
+            (true, true) => {
+                let (pc, pp) = Descent::probabilities(m.cut, m.prior)?;
+                d.choose_with(pc, pp) == Side::Left
+            }
+            (true, false) => true,
+            (false, true) => false,
+            (false, false) => return None,
+        };
+        let mut at = self.root()?;
+        let mut p = Products {
+            cut: 1.0,
+            prior: 1.0,
+        };
+        let mut children = self.tree.children(at.light);
+        let mut split = self.guide.raw_split(at.light);
+        while let Some([l, r]) = children {
+            // Load the next level for both sides before choosing: these
+            // loads do not depend on `u`, so they overlap with this level's
+            // choice instead of waiting for it (the walk is latency-bound).
+            let grand = [self.tree.children(l), self.tree.children(r)];
+            let splits = [self.guide.raw_split(l), self.guide.raw_split(r)];
+            let step = self.step(at, split);
+            let (pl, pr) = if use_cut { step.cut } else { step.prior }?;
+            let side = d.choose_with(pl, pr);
+            self.apply(&mut p, &step, side);
+            let k = side.index();
+            at = Cursor {
+                light: [l, r][k],
+                cut: step.next[k],
+            };
+            children = grand[k];
+            split = splits[k];
+        }
+        let emitter = self.tree.emitter(at.light)?;
+        Some((LightId::Emitter(emitter), m.emitter_pmf(p)))
+    }
+
+    /// The `f64` pmf of `light`: the same steps along its path.
+    pub(crate) fn pmf(&self, light: LightId) -> f64 {
+        let emitter = match light {
+            LightId::Environment => return self.mixture.env,
+            LightId::Emitter(e) => e,
+        };
+        if self.mixture.cut <= 0.0 && !self.prior {
+            return 0.0;
+        }
+        let (Some(mut at), Some(path)) = (self.root(), self.tree.path(emitter)) else {
+            return 0.0;
+        };
+        let mut p = Products {
+            cut: 1.0,
+            prior: 1.0,
+        };
+        for &(node, side) in path.steps() {
+            at.light = node;
+            let step = self.step(at, self.guide.raw_split(node));
+            self.apply(&mut p, &step, side);
+            if p.cut == 0.0 && (!self.prior || p.prior == 0.0) {
+                return 0.0;
+            }
+            at.cut = step.next[side.index()];
+        }
+        self.mixture.emitter_pmf(p)
+    }
+}
+
+/// A sample converted for the [`crate::LightSampler`] interface.
+#[inline]
+pub(crate) fn to_light_sample(s: Option<(LightId, f64)>) -> Option<LightSample> {
+    let (light, pmf) = s?;
+    let pmf = pmf_to_f32(pmf);
+    (pmf > 0.0).then_some(LightSample { light, pmf })
+}
+
+impl<'a, H: LightHierarchy + ?Sized> GuidingTree<'a, H> {
+    /// Chooses a light for a shading point `ctx` in the cell of `cut` from
+    /// one uniform number `u` in `[0, 1)`, by the GLT's sampling rule:
+    ///
+    /// ```text
+    /// pmf(l)   = (1 - alpha) (1 - f) P_cut(l) + alpha (1 - q) P_prior(l)
+    /// pmf(env) = (1 - alpha) f + alpha q
+    /// ```
+    ///
+    /// (`f` the cell's learned environment fraction, `q` the configured
+    /// prior one, `P_prior` tree-by-energy, `P_cut` the cut's learned
+    /// probabilities down to the cut, then the [`BelowCut`] rule; the full
+    /// description is at the top of `src/glt/sampling.rs`). `None` when
+    /// nothing can be chosen or the pmf rounds to zero in `f32`.
+    #[inline]
+    pub fn sample(&self, cut: &GuidingCut, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+        to_light_sample(Rule::new(self, cut, ctx).sample(Descent::new(u)))
+    }
+
+    /// Like [`GuidingTree::sample`] from an `f64` number (53 bits),
+    /// returning the unrounded `f64` pmf: equal, bit for bit, to
+    /// [`GuidingTree::pmf_exact`] for the chosen light.
+    #[inline]
+    pub fn sample_exact(
+        &self,
+        cut: &GuidingCut,
+        ctx: &ShadingContext,
+        u: f64,
+    ) -> Option<(LightId, f64)> {
+        Rule::new(self, cut, ctx).sample(Descent::from_f64(u))
+    }
+
+    /// The probability that [`GuidingTree::sample`] chooses `light` at `ctx`
+    /// with `cut` (0 for lights it never chooses and ids out of range).
+    #[inline]
+    pub fn pmf(&self, cut: &GuidingCut, ctx: &ShadingContext, light: LightId) -> f32 {
+        pmf_to_f32(self.pmf_exact(cut, ctx, light))
+    }
+
+    /// The `f64` pmf before rounding to `f32`.
+    #[inline]
+    pub fn pmf_exact(&self, cut: &GuidingCut, ctx: &ShadingContext, light: LightId) -> f64 {
+        Rule::new(self, cut, ctx).pmf(light)
+    }
+
+    /// `cut` as a [`LightSampler`] (for one cell, or a renderer that keeps
+    /// its own spatial structure).
+    pub fn sampler<'b>(&'b self, cut: &'b GuidingCut) -> CutSampler<'a, 'b, H> {
+        CutSampler { guide: self, cut }
+    }
+}
+
+/// One cell's cut with its [`GuidingTree`], as a [`LightSampler`].
+#[derive(Debug)]
+pub struct CutSampler<'a, 'b, H: LightHierarchy + ?Sized> {
+    guide: &'b GuidingTree<'a, H>,
+    cut: &'b GuidingCut,
+}
+
+impl<H: LightHierarchy + ?Sized> Clone for CutSampler<'_, '_, H> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<H: LightHierarchy + ?Sized> Copy for CutSampler<'_, '_, H> {}
+
+impl<H: LightHierarchy + ?Sized> LightSampler for CutSampler<'_, '_, H> {
+    #[inline]
+    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+        self.guide.sample(self.cut, ctx, u)
+    }
+
+    #[inline]
+    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        self.guide.pmf(self.cut, ctx, light)
+    }
+
+    fn is_empty(&self) -> bool {
+        self.guide.is_empty()
+    }
+}
+
+impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
+    /// True when nothing can ever be sampled: no emitter has power and
+    /// there is no environment light with a positive probability.
+    pub fn is_empty(&self) -> bool {
+        !self.has_energy() && self.config().environment.is_none_or(|q| q <= 0.0)
+    }
+}

@@ -1,0 +1,83 @@
+//! Recording direct-light estimates into a cut's accumulating copy.
+
+use super::cut::GuidingCut;
+use super::guiding_tree::GuidingTree;
+use crate::light_sampler::LightId;
+use crate::light_tree::LightHierarchy;
+
+/// What became of one splat.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SplatOutcome {
+    /// The value was added to a slot's (or the environment's) sum.
+    Recorded,
+    /// The value was zero (an occluded or black sample): a valid
+    /// observation that adds nothing to the sums. It still counts as a
+    /// sample for spatial refinement.
+    Zero,
+    /// Bad input, ignored: a negative, NaN or infinite value, an emitter out
+    /// of range or with zero power (no cut can give it weight), or the
+    /// environment when none is configured.
+    Dropped,
+}
+
+impl GuidingCut {
+    /// Index of the sum that a splat for `emitter` goes to: the first slot on
+    /// its root-to-leaf path that ends the cut. `None` for an emitter out of
+    /// range or with zero power.
+    pub(crate) fn slot_of<H: LightHierarchy + ?Sized>(
+        &self,
+        tree: &H,
+        emitter: u32,
+    ) -> Option<usize> {
+        let path = tree.path(emitter)?;
+        let energy = tree.energy(path.leaf());
+        if energy.is_nan() || energy <= 0.0 {
+            return None;
+        }
+        if self.nodes.is_empty() {
+            return Some(0);
+        }
+        let mut i = 0u32;
+        for &(_, side) in path.steps() {
+            let node = self.nodes.get(i as usize)?;
+            match node.child(side) {
+                Some(j) => i = j,
+                None => return Some(2 * i as usize + side.index()),
+            }
+        }
+        // The path ended inside the cut: only possible for a cut that does
+        // not belong to `tree`.
+        None
+    }
+}
+
+impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
+    /// Records into `cut` `value`, the MIS-weighted direct-light estimate for `light`
+    /// seen from a point of this cell, without BSDF and cosine: from NEE,
+    /// `Le * T * w_mis / (pdf_solid_angle * pmf)`; from a BSDF-sampled
+    /// emitter hit, `Le * w_mis / pdf_direction` (use the luminance, or any
+    /// fixed scalar, of a spectral value). The value goes to the first slot
+    /// on the emitter's path that ends the cut (or to the environment's
+    /// sum). Takes `&self`: any number of threads may splat at once, no
+    /// update is lost.
+    pub fn splat(&self, cut: &GuidingCut, light: LightId, value: f32) -> SplatOutcome {
+        if !(value >= 0.0 && value.is_finite()) {
+            return SplatOutcome::Dropped;
+        }
+        let index = match light {
+            LightId::Emitter(e) => cut.slot_of(self.tree(), e),
+            LightId::Environment => self.config().environment.map(|_| cut.env_sum()),
+        };
+        let Some(index) = index else {
+            return SplatOutcome::Dropped;
+        };
+        if value == 0.0 {
+            return SplatOutcome::Zero;
+        }
+        if cut.sums.add(index, value) {
+            SplatOutcome::Recorded
+        } else {
+            SplatOutcome::Dropped
+        }
+    }
+}

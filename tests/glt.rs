@@ -1,0 +1,1092 @@
+//! The Guiding Light Tree's per-cell core ([`GuidingCut`]): valid cuts under
+//! random splat streams and refinements, the sampling rule's contracts
+//! (pmf sums to 1, `sample`'s pmf equals `pmf()` bit for bit), learning,
+//! unbiasedness with the defensive mixture, numerical stability at depth,
+//! across 60 decades and at 1M lights, concurrency and memory.
+
+use glam::Vec3;
+use guiding::glt::{
+    BelowCut, CutConfig, CutNode, GuidingCut, GuidingTree, Slot, SplatOutcome, SplitPrior,
+};
+use guiding::light_tree::{BuildHeuristic, EmitterPath, NodeBounds};
+use guiding::math::{Aabb, Accumulation, LightCone, Side};
+use guiding::{Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext};
+use proptest::prelude::*;
+use rand_pcg::Pcg64Mcg;
+use rand_pcg::rand_core::{Rng, SeedableRng};
+
+// ---------------------------------------------------------------------------
+// Helpers
+// ---------------------------------------------------------------------------
+
+struct Rand(Pcg64Mcg);
+
+impl Rand {
+    fn new(seed: u64) -> Self {
+        Self(Pcg64Mcg::seed_from_u64(seed))
+    }
+    /// Uniform f32 in [0, 1) on the 2^-24 grid.
+    fn f(&mut self) -> f32 {
+        (self.0.next_u32() >> 8) as f32 / (1u32 << 24) as f32
+    }
+    /// Uniform f64 in [0, 1) on the 2^-53 grid.
+    fn f64(&mut self) -> f64 {
+        (self.0.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.f()
+    }
+    fn below(&mut self, n: u32) -> u32 {
+        (((self.0.next_u64() >> 32) * n as u64) >> 32) as u32
+    }
+    fn point(&mut self, r: f32) -> Vec3 {
+        Vec3::new(self.range(-r, r), self.range(-r, r), self.range(-r, r))
+    }
+}
+
+/// Every leaf of `tree` lies below exactly one cluster of the cut (checked
+/// by counting leaves, independently of `GuidingCut::check`), the structural
+/// check passes, and the clusters' learned probabilities sum to 1.
+fn assert_valid_cut<H: LightHierarchy + ?Sized>(tree: &H, cut: &GuidingCut) {
+    cut.check(tree).unwrap();
+    let mut crossings = vec![0u32; tree.emitter_count()];
+    let clusters = cut.clusters(tree);
+    for &(node, _) in &clusters {
+        let mut stack = vec![node];
+        while let Some(n) = stack.pop() {
+            match tree.children(n) {
+                Some([l, r]) => stack.extend([l, r]),
+                None => crossings[tree.emitter(n).unwrap() as usize] += 1,
+            }
+        }
+    }
+    assert!(
+        crossings.iter().all(|&c| c == 1),
+        "a root-to-leaf path crosses the cut {:?} times",
+        crossings.iter().find(|&&c| c != 1)
+    );
+    if !clusters.is_empty() {
+        let p: f64 = clusters.iter().map(|c| c.1).sum();
+        assert!((p - 1.0).abs() < 1e-5, "cluster probabilities sum to {p}");
+    }
+    // Slots record the light node they end at.
+    let mut stack = vec![];
+    if let (Some(root), false) = (tree.root(), cut.nodes().is_empty()) {
+        stack.push((0u32, root));
+    }
+    while let Some((i, light)) = stack.pop() {
+        let node = cut.nodes()[i as usize];
+        let children = tree.children(light).unwrap();
+        for side in [Side::Left, Side::Right] {
+            match node.slot(side) {
+                Slot::Child(j) => stack.push((j, children[side.index()])),
+                Slot::End(n) => assert_eq!(n, children[side.index()]),
+            }
+        }
+    }
+}
+
+/// Sum of the exact pmf over every emitter and the environment.
+fn pmf_total<H: LightHierarchy + ?Sized>(
+    guide: &GuidingTree<'_, H>,
+    cut: &GuidingCut,
+    ctx: &ShadingContext,
+) -> f64 {
+    let mut total = guide.pmf_exact(cut, ctx, LightId::Environment);
+    for e in 0..guide.tree().emitter_count() as u32 {
+        let p = guide.pmf_exact(cut, ctx, LightId::Emitter(e));
+        assert!(p.is_finite() && p >= 0.0, "pmf {p} for {e}");
+        total += p;
+    }
+    total
+}
+
+/// What the total pmf must be: 1 when anything can be sampled.
+fn expected_total<H: LightHierarchy + ?Sized>(guide: &GuidingTree<'_, H>) -> f64 {
+    let tree = guide.tree();
+    let emitters = tree.root().is_some_and(|r| tree.energy(r) > 0.0);
+    let env = guide.config().environment.is_some();
+    if emitters || env { 1.0 } else { 0.0 }
+}
+
+/// `sample`'s pmf equals `pmf()` bit for bit, in `f64` and in `f32`, and a
+/// sampled light always has a positive pmf.
+fn assert_sample_matches_pmf<H: LightHierarchy + ?Sized>(
+    guide: &GuidingTree<'_, H>,
+    cut: &GuidingCut,
+    ctx: &ShadingContext,
+    rng: &mut Rand,
+    draws: usize,
+) {
+    let sampler = guide.sampler(cut);
+    for _ in 0..draws {
+        let u = rng.f64();
+        if let Some((light, p)) = guide.sample_exact(cut, ctx, u) {
+            let q = guide.pmf_exact(cut, ctx, light);
+            assert_eq!(p.to_bits(), q.to_bits(), "{light:?} u={u}: {p} vs {q}");
+            assert!(p > 0.0);
+        } else {
+            assert_eq!(expected_total(guide), 0.0, "no sample at u={u}");
+        }
+        let u = rng.f();
+        if let Some(s) = sampler.sample(ctx, u) {
+            let q = sampler.pmf(ctx, s.light);
+            assert_eq!(s.pmf.to_bits(), q.to_bits(), "{:?} u={u}", s.light);
+            assert!(s.pmf > 0.0);
+        }
+    }
+}
+
+fn lights_in_box(rng: &mut Rand, n: usize, r: f32) -> Vec<Emitter> {
+    (0..n)
+        .map(|_| Emitter::point(rng.point(r), rng.range(0.1, 10.0)))
+        .collect()
+}
+
+const ALL_CONFIGS: [(BelowCut, SplitPrior); 4] = [
+    (BelowCut::Energy, SplitPrior::Energy),
+    (BelowCut::Energy, SplitPrior::Half),
+    (BelowCut::Importance, SplitPrior::Energy),
+    (BelowCut::Importance, SplitPrior::Half),
+];
+
+// ---------------------------------------------------------------------------
+// Property tests
+// ---------------------------------------------------------------------------
+
+#[derive(Clone, Debug)]
+enum Kind {
+    Point,
+    Sphere,
+    Quad,
+    Dark,
+}
+
+fn emitter_strategy() -> impl Strategy<Value = (f32, f32, f32, f32, Kind)> {
+    (
+        -10.0f32..10.0,
+        -10.0f32..10.0,
+        -10.0f32..10.0,
+        prop_oneof![Just(1.0e-3f32), 0.01f32..100.0, Just(1.0e4)],
+        prop_oneof![
+            Just(Kind::Point),
+            Just(Kind::Sphere),
+            Just(Kind::Quad),
+            Just(Kind::Dark)
+        ],
+    )
+}
+
+fn build_emitter((x, y, z, power, kind): &(f32, f32, f32, f32, Kind)) -> Emitter {
+    let p = Vec3::new(*x, *y, *z);
+    match kind {
+        Kind::Point => Emitter::point(p, *power),
+        Kind::Sphere => Emitter::sphere(p, 0.3, *power),
+        Kind::Quad => {
+            let n = Vec3::new(*y, *z, *x + 0.1).normalize_or(Vec3::Y);
+            Emitter::area(Aabb::new(p - 0.2, p + 0.2), n, 0.16, *power)
+        }
+        Kind::Dark => Emitter::point(p, 0.0),
+    }
+}
+
+#[derive(Clone, Debug)]
+enum Value {
+    Normal(f32),
+    Tiny,
+    Huge,
+    Zero,
+    Negative,
+    Nan,
+    Inf,
+}
+
+impl Value {
+    fn get(&self) -> f32 {
+        match self {
+            Value::Normal(v) => *v,
+            Value::Tiny => 1.0e-30,
+            Value::Huge => 1.0e30,
+            Value::Zero => 0.0,
+            Value::Negative => -1.0,
+            Value::Nan => f32::NAN,
+            Value::Inf => f32::INFINITY,
+        }
+    }
+    fn is_bad(&self) -> bool {
+        matches!(self, Value::Negative | Value::Nan | Value::Inf)
+    }
+}
+
+fn value_strategy() -> impl Strategy<Value = Value> {
+    prop_oneof![
+        8 => (0.0f32..100.0).prop_map(Value::Normal),
+        1 => Just(Value::Tiny),
+        1 => Just(Value::Huge),
+        1 => Just(Value::Zero),
+        1 => Just(Value::Negative),
+        1 => Just(Value::Nan),
+        1 => Just(Value::Inf),
+    ]
+}
+
+fn config_strategy() -> impl Strategy<Value = CutConfig> {
+    (
+        prop_oneof![
+            Just(0.0),
+            Just(0.002),
+            Just(0.01),
+            Just(0.05),
+            Just(0.5),
+            Just(1.0)
+        ],
+        prop_oneof![Just(0.0), Just(0.1), Just(0.5), Just(1.0)],
+        0usize..4,
+        prop_oneof![
+            Just(None),
+            Just(Some(0.0)),
+            Just(Some(0.2)),
+            Just(Some(1.0))
+        ],
+        any::<bool>(),
+    )
+        .prop_map(|(sigma, alpha, variant, environment, exact)| {
+            let (below_cut, split_prior) = ALL_CONFIGS[variant];
+            CutConfig {
+                sigma,
+                alpha,
+                below_cut,
+                split_prior,
+                environment,
+                accumulation: if exact {
+                    Accumulation::Deterministic
+                } else {
+                    Accumulation::Fast
+                },
+            }
+        })
+}
+
+const HEURISTICS: [BuildHeuristic; 4] = [
+    BuildHeuristic::Balanced,
+    BuildHeuristic::Sah,
+    BuildHeuristic::Sarh,
+    BuildHeuristic::Saoh,
+];
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    /// Random light sets, splat streams (bad values and ids included) and
+    /// refinement sequences keep every cut valid, the pmf summing to 1 and
+    /// sampling agreeing with the pmf bit for bit.
+    #[test]
+    fn random_streams_keep_cuts_valid(
+        emitters in prop::collection::vec(emitter_strategy(), 1..120),
+        heuristic in 0usize..4,
+        config in config_strategy(),
+        rounds in prop::collection::vec(
+            prop::collection::vec((0u32..1000, value_strategy()), 0..150),
+            1..5,
+        ),
+        seed in any::<u64>(),
+    ) {
+        let lights: Vec<Emitter> = emitters.iter().map(build_emitter).collect();
+        let tree = LightTree::build(&lights, HEURISTICS[heuristic]).unwrap();
+        let guide = GuidingTree::new(&tree, config);
+        let n = lights.len() as u32;
+        let mut rng = Rand::new(seed);
+        let mut cut = guide.new_cut();
+        assert_valid_cut(&tree, &cut);
+        for round in &rounds {
+            for (id, value) in round {
+                // Mostly real emitters, some out of range, some environment.
+                let light = match id % 10 {
+                    0 => LightId::Environment,
+                    1 => LightId::Emitter(n + id),
+                    _ => LightId::Emitter(id % n),
+                };
+                let outcome = guide.splat(&cut, light, value.get());
+                let dark = match light {
+                    LightId::Emitter(e) => e >= n || lights[e as usize].power == 0.0,
+                    LightId::Environment => config.environment.is_none(),
+                };
+                if value.is_bad() || dark {
+                    prop_assert_eq!(outcome, SplatOutcome::Dropped);
+                } else if value.get() == 0.0 {
+                    prop_assert_eq!(outcome, SplatOutcome::Zero);
+                } else {
+                    prop_assert_eq!(outcome, SplatOutcome::Recorded);
+                }
+            }
+            guide.refine(&mut cut);
+            assert_valid_cut(&tree, &cut);
+            for _ in 0..3 {
+                let normal = if rng.f() < 0.5 { Some(rng.point(1.0)) } else { None };
+                let ctx = ShadingContext {
+                    position: rng.point(12.0),
+                    normal: normal.and_then(|n| n.try_normalize()),
+                };
+                let total = pmf_total(&guide, &cut, &ctx);
+                let expect = expected_total(&guide);
+                prop_assert!((total - expect).abs() < 1e-5, "pmf sums to {} not {}", total, expect);
+                assert_sample_matches_pmf(&guide, &cut, &ctx, &mut rng, 40);
+            }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Behaviour of the learned cut
+// ---------------------------------------------------------------------------
+
+/// 64 point lights on a ring; only every 8th is visible from the origin.
+/// Training as a renderer would (sample from the cut, splat
+/// contribution / pmf) moves the pmf mass onto the visible subset, up to
+/// `1 - alpha * (prior mass outside it)`.
+#[test]
+fn learns_the_visible_subset() {
+    let lights: Vec<Emitter> = (0..64)
+        .map(|i| {
+            let a = i as f32 / 64.0 * core::f32::consts::TAU;
+            Emitter::point(
+                Vec3::new(5.0 * a.cos(), 1.0, 5.0 * a.sin()),
+                1.0 + (i % 5) as f32,
+            )
+        })
+        .collect();
+    let visible = |e: u32| e % 8 == 3;
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let ctx = ShadingContext::on_surface(Vec3::ZERO, Vec3::Y);
+    let total_power: f32 = lights.iter().map(|l| l.power).sum();
+    let prior_outside: f64 = (0..64)
+        .filter(|&e| !visible(e))
+        .map(|e| (lights[e as usize].power / total_power) as f64)
+        .sum();
+    for (below_cut, split_prior) in ALL_CONFIGS {
+        for alpha in [0.0, 0.1, 0.3] {
+            let config = CutConfig {
+                alpha,
+                below_cut,
+                split_prior,
+                ..CutConfig::default()
+            };
+            let guide = GuidingTree::new(&tree, config);
+            let mass = |cut: &GuidingCut| -> f64 {
+                (0..64)
+                    .filter(|&e| visible(e))
+                    .map(|e| guide.pmf_exact(cut, &ctx, LightId::Emitter(e)))
+                    .sum()
+            };
+            let mut cut = guide.new_cut();
+            let before = mass(&cut);
+            let mut rng = Rand::new(7);
+            for _ in 0..4 {
+                for _ in 0..2000 {
+                    let s = guide.sample(&cut, &ctx, rng.f()).unwrap();
+                    let LightId::Emitter(e) = s.light else {
+                        panic!()
+                    };
+                    let c = if visible(e) {
+                        lights[e as usize].power
+                    } else {
+                        0.0
+                    };
+                    guide.splat(&cut, s.light, c / s.pmf);
+                }
+                guide.refine(&mut cut);
+            }
+            let after = mass(&cut);
+            let target = 1.0 - alpha * prior_outside;
+            assert!(before < 0.2, "{before}");
+            assert!(
+                after > target - 1e-4 && after < target + 1e-4,
+                "{below_cut:?} {split_prior:?} alpha {alpha}: mass {after}, target {target}"
+            );
+        }
+    }
+}
+
+/// With `SplitPrior::Energy` a freshly split cluster samples exactly as
+/// before the split; with `Half` it does not (the test can tell them apart).
+#[test]
+fn energy_split_prior_preserves_the_distribution() {
+    let mut rng = Rand::new(3);
+    let lights = lights_in_box(&mut rng, 200, 5.0);
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let ctx = ShadingContext::at(Vec3::ZERO);
+    let [l, r] = tree.children(tree.root().unwrap()).unwrap();
+    for prior in [SplitPrior::Energy, SplitPrior::Half] {
+        let config = CutConfig {
+            alpha: 0.0,
+            split_prior: prior,
+            sigma: 0.002,
+            ..CutConfig::default()
+        };
+        let guide = GuidingTree::new(&tree, config);
+        let mut cut = guide.new_cut();
+        let before: Vec<f64> = (0..200)
+            .map(|e| guide.pmf_exact(&cut, &ctx, LightId::Emitter(e)))
+            .collect();
+        // Sums exactly in the ratio of the root's children's energies: the
+        // root keeps its p_left, every slot below is split afresh.
+        let first_light = |mut n: u32| {
+            while let Some([c, _]) = tree.children(n) {
+                n = c;
+            }
+            tree.emitter(n).unwrap()
+        };
+        guide.splat(&cut, LightId::Emitter(first_light(l)), tree.energy(l));
+        guide.splat(&cut, LightId::Emitter(first_light(r)), tree.energy(r));
+        guide.refine(&mut cut);
+        assert!(cut.nodes().len() > 50, "{}", cut.nodes().len());
+        assert_valid_cut(&tree, &cut);
+        let worst = (0..200)
+            .map(|e| {
+                let p = guide.pmf_exact(&cut, &ctx, LightId::Emitter(e));
+                (p / before[e as usize] - 1.0).abs()
+            })
+            .fold(0.0, f64::max);
+        match prior {
+            SplitPrior::Energy => assert!(worst < 1e-5, "relative change {worst}"),
+            SplitPrior::Half => assert!(worst > 0.1, "relative change {worst}"),
+        }
+    }
+}
+
+/// Splitting goes down to single emitters; a concentrated stream then
+/// merges everything else back into few clusters.
+#[test]
+fn splits_to_leaves_and_merges_back() {
+    let mut rng = Rand::new(5);
+    let lights = lights_in_box(&mut rng, 300, 5.0);
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let config = CutConfig::default();
+    let guide = GuidingTree::new(&tree, config);
+    let mut cut = guide.new_cut();
+    // Uniform contributions: every emitter's share 1/300 < sigma, so the cut
+    // stops above the leaves but grows large.
+    for e in 0..300 {
+        guide.splat(&cut, LightId::Emitter(e), 1.0);
+    }
+    guide.refine(&mut cut);
+    let wide = cut.nodes().len();
+    assert!(wide > 40, "{wide}");
+    // One emitter holds everything: the cut becomes its path (single
+    // emitter at the end), all else merges. The first pass splits the old
+    // cluster of emitter 17 by the energy prior; the second learns that its
+    // siblings got nothing.
+    for _ in 0..2 {
+        for _ in 0..10 {
+            guide.splat(&cut, LightId::Emitter(17), 5.0);
+        }
+        guide.refine(&mut cut);
+    }
+    assert_valid_cut(&tree, &cut);
+    let path = tree.path(17).unwrap();
+    assert_eq!(cut.nodes().len(), path.depth());
+    let clusters = cut.clusters(&tree);
+    let leaf = clusters.iter().find(|c| c.0 == path.leaf()).unwrap();
+    assert!((leaf.1 - 1.0).abs() < 1e-6);
+    // A cell that then collects nothing keeps its cut.
+    let before = cut.nodes().to_vec();
+    assert!(!guide.refine(&mut cut));
+    assert_eq!(cut.nodes(), &before[..]);
+}
+
+// ---------------------------------------------------------------------------
+// Unbiasedness
+// ---------------------------------------------------------------------------
+
+/// A wall in the plane x = 0 for 0 < y < 3 blocks the segment between a
+/// shading point and a light when the segment crosses it there.
+fn visible(p: Vec3, l: Vec3) -> bool {
+    if (p.x < 0.0) == (l.x < 0.0) {
+        return true;
+    }
+    let t = p.x / (p.x - l.x);
+    let y = p.y + t * (l.y - p.y);
+    !(0.0..3.0).contains(&y)
+}
+
+/// The direct illumination of light `l` at `p` (normal +Y): power x cosine
+/// / (4 pi d^2), times visibility.
+fn contribution(light: &Emitter, p: Vec3) -> f64 {
+    let c = light.bounds.center();
+    let d = c - p;
+    let cos = (d.y / d.length()).max(0.0) as f64;
+    if !visible(p, c) {
+        return 0.0;
+    }
+    light.power as f64 * cos / (4.0 * core::f64::consts::PI * d.length_squared() as f64)
+}
+
+/// The GLT-sampled estimate of direct illumination matches brute force
+/// within 4 standard errors, with delta lights that never received a splat
+/// (a renderer that learns only from BSDF hits). With `alpha = 0` those
+/// lights have pmf 0: that estimator would be biased, which this scene
+/// detects.
+#[test]
+fn estimate_is_unbiased_with_the_defensive_mixture() {
+    let mut rng = Rand::new(11);
+    let lights: Vec<Emitter> = (0..60)
+        .map(|i| {
+            let p = Vec3::new(
+                rng.range(-6.0, 6.0),
+                rng.range(1.0, 6.0),
+                rng.range(-6.0, 6.0),
+            );
+            if i % 4 == 0 {
+                Emitter::point(p, rng.range(5.0, 50.0))
+            } else {
+                Emitter::sphere(p, 0.1, rng.range(1.0, 20.0))
+            }
+        })
+        .collect();
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let points = [
+        Vec3::new(-2.0, 0.0, 0.5),
+        Vec3::new(3.0, 0.0, -1.0),
+        Vec3::new(-0.5, 0.0, 4.0),
+    ];
+    for (below_cut, split_prior) in ALL_CONFIGS {
+        let train = CutConfig {
+            below_cut,
+            split_prior,
+            ..CutConfig::default()
+        };
+        let guide = GuidingTree::new(&tree, train);
+        for (k, &p) in points.iter().enumerate() {
+            let ctx = ShadingContext::on_surface(p, Vec3::Y);
+            let truth: f64 = lights.iter().map(|l| contribution(l, p)).sum();
+            // Learn from area lights only, proportional to their
+            // contribution (with multiplicative noise).
+            let mut cut = guide.new_cut();
+            for _ in 0..3 {
+                for _ in 0..3000 {
+                    let e = rng.below(60);
+                    if !lights[e as usize].delta {
+                        let v = contribution(&lights[e as usize], p) * (0.5 + rng.f() as f64);
+                        guide.splat(&cut, LightId::Emitter(e), v as f32);
+                    }
+                }
+                guide.refine(&mut cut);
+            }
+            let blind = CutConfig {
+                alpha: 0.0,
+                ..train
+            };
+            let blind_guide = GuidingTree::new(&tree, blind);
+            let biased: f64 = (0..60u32)
+                .filter(|&e| blind_guide.pmf_exact(&cut, &ctx, LightId::Emitter(e)) > 0.0)
+                .map(|e| contribution(&lights[e as usize], p))
+                .sum();
+            assert!(
+                biased < truth * 0.99,
+                "point {k}: alpha = 0 misses nothing ({biased} vs {truth})"
+            );
+            let n = 100_000;
+            let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+            for _ in 0..n {
+                let s = guide.sample(&cut, &ctx, rng.f()).unwrap();
+                let LightId::Emitter(e) = s.light else {
+                    panic!()
+                };
+                let x = contribution(&lights[e as usize], p) / s.pmf as f64;
+                sum += x;
+                sum2 += x * x;
+            }
+            let mean = sum / n as f64;
+            let se = ((sum2 / n as f64 - mean * mean) / (n - 1) as f64).sqrt();
+            assert!(
+                (mean - truth).abs() < 4.0 * se,
+                "{below_cut:?} {split_prior:?} point {k}: {mean} vs {truth} (se {se})"
+            );
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Numerical stability
+// ---------------------------------------------------------------------------
+
+/// A caterpillar hierarchy: inner node `k` has leaf `k` on the left and the
+/// rest of the chain on the right, so leaf `k` sits at depth `k + 1` (the
+/// last two at depth `n - 1`). Inner `k` = node `2k`, leaf `k` = node
+/// `2k + 1`, the last leaf is node `2n - 2`.
+struct Chain {
+    energy: Vec<f32>,
+    subtree: Vec<f32>,
+}
+
+impl Chain {
+    fn new(energy: Vec<f32>) -> Self {
+        let n = energy.len();
+        let mut subtree = vec![0.0f32; n];
+        let mut acc = 0.0f64;
+        for k in (0..n).rev() {
+            acc += energy[k] as f64;
+            subtree[k] = acc as f32;
+        }
+        Self { energy, subtree }
+    }
+    fn n(&self) -> u32 {
+        self.energy.len() as u32
+    }
+    fn leaf_node(&self, e: u32) -> u32 {
+        if e == self.n() - 1 { 2 * e } else { 2 * e + 1 }
+    }
+}
+
+impl LightHierarchy for Chain {
+    fn root(&self) -> Option<u32> {
+        Some(0)
+    }
+    fn children(&self, node: u32) -> Option<[u32; 2]> {
+        let n = self.n();
+        if node % 2 == 1 || node == 2 * n - 2 {
+            return None;
+        }
+        let k = node / 2;
+        Some([2 * k + 1, 2 * k + 2])
+    }
+    fn parent(&self, node: u32) -> Option<u32> {
+        if node == 0 {
+            None
+        } else if node % 2 == 1 {
+            Some(node - 1)
+        } else {
+            Some(node - 2)
+        }
+    }
+    fn energy(&self, node: u32) -> f32 {
+        match self.emitter(node) {
+            Some(e) => self.energy[e as usize],
+            None => self.subtree[(node / 2) as usize],
+        }
+    }
+    fn node_bounds(&self, node: u32) -> NodeBounds {
+        NodeBounds {
+            bounds: Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0)),
+            cone: LightCone::SPHERE,
+            two_sided: false,
+            energy: self.energy(node),
+        }
+    }
+    fn emitter(&self, node: u32) -> Option<u32> {
+        let n = self.n();
+        if node == 2 * n - 2 {
+            Some(n - 1)
+        } else if node % 2 == 1 {
+            Some(node / 2)
+        } else {
+            None
+        }
+    }
+    fn leaf(&self, emitter: u32) -> Option<u32> {
+        (emitter < self.n()).then(|| self.leaf_node(emitter))
+    }
+    fn node_count(&self) -> usize {
+        2 * self.energy.len() - 1
+    }
+    fn emitter_count(&self) -> usize {
+        self.energy.len()
+    }
+}
+
+/// One uniform number per descent stays exact in distribution through the
+/// cut and the tree together, 100 levels deep: the cut covers the first 70
+/// levels, energy descent the last 30. Chi-square over the 100 leaves
+/// against `pmf()`, with f32 and f64 numbers. (An f32 rescaling, as in the
+/// paper's code, never reaches leaves past depth ~24 and fails this.)
+#[test]
+fn deep_chain_is_exact_in_distribution() {
+    let n = 100u32;
+    let chain = Chain::new((0..n).map(|k| 1.0 + ((k * 7) % 5) as f32).collect());
+    for (below_cut, split_prior) in ALL_CONFIGS {
+        let config = CutConfig {
+            below_cut,
+            split_prior,
+            ..CutConfig::default()
+        };
+        let guide = GuidingTree::new(&chain, config);
+        let mut cut = guide.new_cut();
+        // Learned targets: large for k < 70 (skewed), small tail whose total
+        // share (< sigma) ends the cut at depth 70. Fresh half splits reach
+        // a few levels deeper per pass, energy splits all the way.
+        for _ in 0..16 {
+            for k in 0..n {
+                let t = if k < 70 {
+                    1.0 + ((k * 3) % 7) as f32
+                } else {
+                    0.05
+                };
+                guide.splat(&cut, LightId::Emitter(k), t);
+            }
+            guide.refine(&mut cut);
+        }
+        assert_valid_cut(&chain, &cut);
+        assert_eq!(cut.nodes().len(), 70, "the cut ends at depth 70");
+        let ctx = ShadingContext::at(Vec3::new(3.0, 0.0, 0.0));
+        let pmf: Vec<f64> = (0..n)
+            .map(|k| guide.pmf_exact(&cut, &ctx, LightId::Emitter(k)))
+            .collect();
+        assert!((pmf.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+        assert!(pmf[99] > 1e-4, "{}", pmf[99]);
+        let draws = 200_000;
+        let mut rng = Rand::new(99);
+        for exact in [false, true] {
+            let mut counts = vec![0u64; n as usize];
+            for _ in 0..draws {
+                let light = if exact {
+                    guide.sample_exact(&cut, &ctx, rng.f64()).unwrap().0
+                } else {
+                    guide.sample(&cut, &ctx, rng.f()).unwrap().light
+                };
+                let LightId::Emitter(e) = light else { panic!() };
+                counts[e as usize] += 1;
+            }
+            let chi2: f64 = (0..n as usize)
+                .map(|k| {
+                    let expect = pmf[k] * draws as f64;
+                    (counts[k] as f64 - expect).powi(2) / expect
+                })
+                .sum();
+            // 99 degrees of freedom: mean 99, sd 14; 200 is > 7 sd.
+            assert!(
+                chi2 < 200.0,
+                "{below_cut:?} {split_prior:?} exact={exact}: chi2 {chi2}"
+            );
+            assert!(counts[99] > 0 && counts[98] > 0);
+        }
+    }
+}
+
+/// Sums spanning 1e-30..1e30 in one cell: no NaN, valid cut, pmf sums to 1,
+/// sample and pmf agree; the tiny ones keep their prior floor.
+#[test]
+fn sums_across_sixty_decades() {
+    let mut rng = Rand::new(21);
+    let lights = lights_in_box(&mut rng, 500, 8.0);
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    for accumulation in [Accumulation::Fast, Accumulation::Deterministic] {
+        let config = CutConfig {
+            accumulation,
+            environment: Some(0.1),
+            ..CutConfig::default()
+        };
+        let guide = GuidingTree::new(&tree, config);
+        let mut cut = guide.new_cut();
+        for round in 0..3 {
+            for e in 0..500u32 {
+                let decade = (e * 7 + round) % 61;
+                let v = 10f32.powi(decade as i32 - 30);
+                guide.splat(&cut, LightId::Emitter(e), v);
+            }
+            guide.splat(&cut, LightId::Environment, 1.0e-30);
+            guide.refine(&mut cut);
+            assert_valid_cut(&tree, &cut);
+            for _ in 0..3 {
+                let ctx = ShadingContext::on_surface(rng.point(9.0), Vec3::Y);
+                let total = pmf_total(&guide, &cut, &ctx);
+                assert!((total - 1.0).abs() < 1e-5, "{total}");
+                for e in 0..500 {
+                    let p = guide.pmf_exact(&cut, &ctx, LightId::Emitter(e));
+                    assert!(p > 0.0, "emitter {e} lost its floor");
+                }
+                assert_sample_matches_pmf(&guide, &cut, &ctx, &mut rng, 300);
+            }
+        }
+    }
+}
+
+/// Empty, single-light and two-light scenes, with and without an
+/// environment light and the mixture.
+#[test]
+fn tiny_scenes() {
+    let one = vec![Emitter::point(Vec3::ONE, 2.0)];
+    let two = vec![
+        Emitter::point(Vec3::ONE, 2.0),
+        Emitter::point(Vec3::ZERO, 6.0),
+    ];
+    let none: Vec<Emitter> = Vec::new();
+    let dark = vec![
+        Emitter::point(Vec3::ONE, 0.0),
+        Emitter::point(Vec3::ZERO, 0.0),
+    ];
+    let mut rng = Rand::new(1);
+    for lights in [&none, &one, &two, &dark] {
+        let tree = LightTree::build(lights, BuildHeuristic::Sarh).unwrap();
+        for environment in [None, Some(0.25)] {
+            for alpha in [0.0, 0.1] {
+                let config = CutConfig {
+                    alpha,
+                    environment,
+                    ..CutConfig::default()
+                };
+                let guide = GuidingTree::new(&tree, config);
+                let mut cut = guide.new_cut();
+                let ctx = ShadingContext::at(Vec3::splat(0.5));
+                for round in 0..3 {
+                    assert_valid_cut(&tree, &cut);
+                    let total = pmf_total(&guide, &cut, &ctx);
+                    assert!((total - expected_total(&guide)).abs() < 1e-6);
+                    assert_sample_matches_pmf(&guide, &cut, &ctx, &mut rng, 50);
+                    for e in 0..lights.len() as u32 {
+                        guide.splat(&cut, LightId::Emitter(e), 1.0 + e as f32);
+                    }
+                    if round == 1 {
+                        guide.splat(&cut, LightId::Environment, 3.0);
+                    }
+                    guide.refine(&mut cut);
+                }
+            }
+        }
+        if lights.len() == 1 {
+            let config = CutConfig::default();
+            let guide = GuidingTree::new(&tree, config);
+            let cut = guide.new_cut();
+            assert!(cut.nodes().is_empty());
+            let s = guide.sample(&cut, &ShadingContext::at(Vec3::ZERO), 0.7);
+            assert_eq!(
+                s.map(|s| (s.light, s.pmf)),
+                Some((LightId::Emitter(0), 1.0))
+            );
+        }
+    }
+}
+
+/// Subtrees whose emitters all have zero power: never sampled, splats to
+/// them dropped, the rest sums to 1 under both split priors.
+#[test]
+fn zero_power_subtrees() {
+    let mut rng = Rand::new(8);
+    // Dark lights on one side of the scene so whole subtrees are dark.
+    let lights: Vec<Emitter> = (0..200)
+        .map(|i| {
+            let mut p = rng.point(5.0);
+            if i < 100 {
+                p.x = -10.0 - p.x.abs();
+                Emitter::point(p, 0.0)
+            } else {
+                Emitter::point(p, rng.range(0.5, 2.0))
+            }
+        })
+        .collect();
+    let tree = LightTree::build(&lights, BuildHeuristic::Balanced).unwrap();
+    let [l, r] = tree.children(tree.root().unwrap()).unwrap();
+    assert!(tree.energy(l) == 0.0 || tree.energy(r) == 0.0);
+    for (below_cut, split_prior) in ALL_CONFIGS {
+        let config = CutConfig {
+            below_cut,
+            split_prior,
+            sigma: 0.0,
+            ..CutConfig::default()
+        };
+        let guide = GuidingTree::new(&tree, config);
+        let mut cut = guide.new_cut();
+        for _ in 0..3 {
+            for e in 0..200u32 {
+                let o = guide.splat(&cut, LightId::Emitter(e), 1.0);
+                assert_eq!(o == SplatOutcome::Dropped, e < 100);
+            }
+            guide.refine(&mut cut);
+            assert_valid_cut(&tree, &cut);
+            let ctx = ShadingContext::on_surface(rng.point(5.0), Vec3::X);
+            assert!((pmf_total(&guide, &cut, &ctx) - 1.0).abs() < 1e-6);
+            for e in 0..100 {
+                assert_eq!(guide.pmf(&cut, &ctx, LightId::Emitter(e)), 0.0);
+            }
+            assert_sample_matches_pmf(&guide, &cut, &ctx, &mut rng, 300);
+        }
+    }
+}
+
+/// The energy prior keeps `f32` relative precision on both sides of every
+/// split: lights with 1e-12 and 3e-10 of the total power keep their floor
+/// `alpha * power / total` after the cut learned only the bright one (a
+/// plain `f32` `p_left` would round their side to 0).
+#[test]
+fn prior_floor_survives_extreme_ratios() {
+    let lights = vec![
+        Emitter::point(Vec3::ZERO, 3.0e9),
+        Emitter::point(Vec3::X, 3.0e-3),
+        Emitter::point(Vec3::Y, 1.0),
+    ];
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let guide = GuidingTree::new(&tree, CutConfig::default());
+    let alpha = guide.config().alpha;
+    let mut cut = guide.new_cut();
+    for _ in 0..3 {
+        guide.splat(&cut, LightId::Emitter(0), 1.0);
+        guide.refine(&mut cut);
+    }
+    let ctx = ShadingContext::at(Vec3::ONE);
+    let total: f64 = lights.iter().map(|l| l.power as f64).sum();
+    for e in 1..3u32 {
+        let p = guide.pmf_exact(&cut, &ctx, LightId::Emitter(e));
+        let expect = alpha * lights[e as usize].power as f64 / total;
+        assert!(
+            (p / expect - 1.0).abs() < 1e-5,
+            "light {e}: {p} vs {expect}"
+        );
+    }
+    assert!((pmf_total(&guide, &cut, &ctx) - 1.0).abs() < 1e-12);
+}
+
+/// A million lights (Balanced build for speed): no NaN, pmf sums to 1,
+/// sample and pmf agree after training.
+#[test]
+fn a_million_lights() {
+    let mut rng = Rand::new(1_000_000);
+    let lights: Vec<Emitter> = (0..1_000_000)
+        .map(|_| Emitter::point(rng.point(100.0), rng.range(0.0, 1.0).powi(4)))
+        .collect();
+    let tree = LightTree::build(&lights, BuildHeuristic::Balanced).unwrap();
+    let config = CutConfig::default();
+    let guide = GuidingTree::new(&tree, config);
+    let mut cut = guide.new_cut();
+    let ctx = ShadingContext::on_surface(Vec3::new(10.0, -3.0, 5.0), Vec3::Y);
+    for _ in 0..2 {
+        for _ in 0..100_000 {
+            let s = guide.sample(&cut, &ctx, rng.f()).unwrap();
+            let LightId::Emitter(e) = s.light else {
+                panic!()
+            };
+            // Only lights in one octant contribute.
+            let c = lights[e as usize].bounds.min;
+            let v = if c.x > 0.0 && c.y > 0.0 && c.z > 0.0 {
+                lights[e as usize].power
+            } else {
+                0.0
+            };
+            guide.splat(&cut, s.light, v / s.pmf);
+        }
+        guide.refine(&mut cut);
+    }
+    assert_valid_cut(&tree, &cut);
+    assert!(cut.nodes().len() > 30);
+    let total = pmf_total(&guide, &cut, &ctx);
+    assert!((total - 1.0).abs() < 1e-5, "{total}");
+    assert_sample_matches_pmf(&guide, &cut, &ctx, &mut rng, 20_000);
+}
+
+// ---------------------------------------------------------------------------
+// Concurrency and memory
+// ---------------------------------------------------------------------------
+
+/// Splats from four threads give the same learned cut as a serial run: bit
+/// for bit in deterministic mode, to f32 rounding in fast mode.
+#[test]
+fn threads_equal_serial() {
+    let mut rng = Rand::new(4);
+    let lights = lights_in_box(&mut rng, 400, 5.0);
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let stream: Vec<(LightId, f32)> = (0..40_000)
+        .map(|i| {
+            let light = if i % 97 == 0 {
+                LightId::Environment
+            } else {
+                LightId::Emitter(rng.below(400) % (rng.below(400) + 1))
+            };
+            (light, rng.range(0.0, 1.0).powi(3) * 1.0e3 + 1.0e-7)
+        })
+        .collect();
+    for accumulation in [Accumulation::Deterministic, Accumulation::Fast] {
+        let config = CutConfig {
+            accumulation,
+            environment: Some(0.05),
+            sigma: 0.002,
+            ..CutConfig::default()
+        };
+        let guide = GuidingTree::new(&tree, config);
+        let mut serial = guide.new_cut();
+        let mut parallel = serial.clone();
+        for round in 0..3 {
+            let chunk = &stream[round * 10_000..(round + 1) * 10_000];
+            for &(light, v) in chunk {
+                guide.splat(&serial, light, v);
+            }
+            std::thread::scope(|s| {
+                for t in 0..4 {
+                    let (cut, guide) = (&parallel, &guide);
+                    s.spawn(move || {
+                        for &(light, v) in chunk.iter().skip(t).step_by(4) {
+                            guide.splat(cut, light, v);
+                        }
+                    });
+                }
+            });
+            if accumulation == Accumulation::Deterministic {
+                assert_eq!(serial.accumulated(), parallel.accumulated());
+            }
+            guide.refine(&mut serial);
+            guide.refine(&mut parallel);
+            let (a, b) = (serial.nodes(), parallel.nodes());
+            match accumulation {
+                Accumulation::Deterministic => {
+                    let bytes_a: &[u8] = bytemuck::cast_slice(a);
+                    let bytes_b: &[u8] = bytemuck::cast_slice(b);
+                    assert_eq!(bytes_a, bytes_b);
+                    assert_eq!(
+                        serial.env_fraction().to_bits(),
+                        parallel.env_fraction().to_bits()
+                    );
+                }
+                Accumulation::Fast => {
+                    assert_eq!(a.len(), b.len());
+                    for (x, y) in a.iter().zip(b) {
+                        assert_eq!(x.slot(Side::Left), y.slot(Side::Left));
+                        assert_eq!(x.slot(Side::Right), y.slot(Side::Right));
+                        assert!((x.p_left() - y.p_left()).abs() <= 1e-6);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A cut node is 12 bytes, and the memory report counts them so.
+#[test]
+fn cut_node_is_twelve_bytes() {
+    assert_eq!(CutNode::BYTES, 12);
+    assert_eq!(std::mem::size_of::<CutNode>(), 12);
+    let mut rng = Rand::new(2);
+    let lights = lights_in_box(&mut rng, 100, 5.0);
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    for (accumulation, per_sum) in [(Accumulation::Fast, 8), (Accumulation::Deterministic, 48)] {
+        let config = CutConfig {
+            accumulation,
+            ..CutConfig::default()
+        };
+        let guide = GuidingTree::new(&tree, config);
+        let mut cut = guide.new_cut();
+        for e in 0..100 {
+            guide.splat(&cut, LightId::Emitter(e), 1.0 + (e % 3) as f32);
+        }
+        guide.refine(&mut cut);
+        let m = cut.memory();
+        assert_eq!(m.nodes, cut.nodes().len());
+        assert_eq!(m.node_bytes, 12 * m.nodes);
+        assert_eq!(m.sum_bytes, per_sum * (2 * m.nodes + 1));
+        assert_eq!(cut.heap_bytes(), m.node_bytes + m.sum_bytes);
+    }
+}
+
+/// The test hierarchy itself: leaf `k` at depth `k + 1`, parents and
+/// children agree, energies add up.
+#[test]
+fn chain_hierarchy_is_consistent() {
+    let chain = Chain::new((0..80).map(|k| k as f32).collect());
+    for k in 0..79u32 {
+        let path: EmitterPath = chain.path(k).unwrap();
+        assert_eq!(path.depth(), k as usize + 1);
+        assert_eq!(chain.emitter(path.leaf()), Some(k));
+    }
+    assert_eq!(chain.path(79).unwrap().depth(), 79);
+    assert_eq!(chain.energy(0), (0..80).sum::<u32>() as f32);
+    for node in 1..chain.node_count() as u32 {
+        let parent = chain.parent(node).unwrap();
+        assert!(chain.children(parent).unwrap().contains(&node));
+    }
+}

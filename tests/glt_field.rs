@@ -1,0 +1,412 @@
+//! The Guiding Light Tree over its own spatial tree ([`Glt`]): the
+//! light-sampler contract at random points, learning that differs across
+//! space, spatial refinement copying cuts, jittered splats, bad input
+//! counted, threads equal a serial run, and the memory report.
+
+use glam::Vec3;
+use guiding::glt::{CutConfig, Glt, GltConfig, GltMemory, SplatOutcome};
+use guiding::light_tree::BuildHeuristic;
+use guiding::math::{Aabb, Accumulation};
+use guiding::spatial::SpatialTree;
+use guiding::{Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext};
+use rand_pcg::Pcg64Mcg;
+use rand_pcg::rand_core::{Rng, SeedableRng};
+
+struct Rand(Pcg64Mcg);
+
+impl Rand {
+    fn new(seed: u64) -> Self {
+        Self(Pcg64Mcg::seed_from_u64(seed))
+    }
+    fn f(&mut self) -> f32 {
+        (self.0.next_u32() >> 8) as f32 / (1u32 << 24) as f32
+    }
+    fn f64(&mut self) -> f64 {
+        (self.0.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.f()
+    }
+    fn point(&mut self, r: f32) -> Vec3 {
+        Vec3::new(self.range(-r, r), self.range(-r, r), self.range(-r, r))
+    }
+}
+
+/// 40 lights at x = -8 and 40 at x = +8; a wall at x = 0 means each half of
+/// the scene sees only its own side's lights.
+fn two_rooms() -> Vec<Emitter> {
+    let mut rng = Rand::new(17);
+    (0..80)
+        .map(|i| {
+            let x = if i < 40 { -8.0 } else { 8.0 };
+            Emitter::point(
+                Vec3::new(x, rng.range(-4.0, 4.0), rng.range(-4.0, 4.0)),
+                rng.range(1.0, 3.0),
+            )
+        })
+        .collect()
+}
+
+fn scene() -> Aabb {
+    Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0))
+}
+
+/// Contribution of light `e` at `p` in the two rooms.
+fn value(lights: &[Emitter], e: u32, p: Vec3) -> f32 {
+    let c = lights[e as usize].bounds.center();
+    if (c.x < 0.0) != (p.x < 0.0) {
+        return 0.0;
+    }
+    lights[e as usize].power / (c - p).length_squared().max(1.0)
+}
+
+/// Trains `glt` for `iterations` iterations of `per_iteration` jittered
+/// splats, sampling lights from the GLT itself as a renderer would.
+fn train(
+    glt: &mut Glt<'_, LightTree>,
+    lights: &[Emitter],
+    rng: &mut Rand,
+    iterations: usize,
+    per_iteration: usize,
+) {
+    for _ in 0..iterations {
+        for _ in 0..per_iteration {
+            let p = rng.point(9.5);
+            let ctx = ShadingContext::at(p);
+            let s = glt.sample(&ctx, rng.f()).unwrap();
+            let LightId::Emitter(e) = s.light else {
+                panic!()
+            };
+            let v = value(lights, e, p) / s.pmf;
+            assert_ne!(glt.splat(p, s.light, v, &mut rng.0), SplatOutcome::Dropped);
+        }
+        glt.refine();
+    }
+}
+
+fn small_config() -> GltConfig {
+    GltConfig {
+        spatial_threshold: 500.0,
+        ..GltConfig::default()
+    }
+}
+
+/// Spatial cells learn different cuts: after training, a point in the left
+/// room puts almost all mass on left lights and vice versa. Every cell's
+/// cut is valid, and the light-sampler contract holds at random points.
+#[test]
+fn learns_per_region_and_keeps_the_contract() {
+    let lights = two_rooms();
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let mut glt = Glt::new(&tree, scene(), small_config()).unwrap();
+    let mut rng = Rand::new(1);
+    train(&mut glt, &lights, &mut rng, 4, 8000);
+    assert!(
+        glt.spatial().cell_count() >= 4,
+        "{}",
+        glt.spatial().cell_count()
+    );
+    assert_eq!(glt.iteration(), 4);
+    for cell in glt.spatial().data_slice() {
+        cell.cut().check(&tree).unwrap();
+    }
+    let alpha = glt.config().cut.alpha;
+    // Points whose cells' filter boxes do not reach across the wall (cells
+    // next to it also learn from the other room through the +-1/2-cell
+    // jitter, as PPG's stochastic box filter does).
+    for (p, own) in [
+        (Vec3::new(-8.0, 0.0, 0.0), 0..40u32),
+        (Vec3::new(8.0, 1.0, -2.0), 40..80),
+    ] {
+        let ctx = ShadingContext::at(p);
+        let mass: f64 = own.map(|e| glt.pmf_exact(&ctx, LightId::Emitter(e))).sum();
+        // The prior puts about half on each side; the floor alone keeps
+        // alpha / 2 on the other.
+        assert!(mass > 1.0 - alpha * 0.5 - 0.02, "mass {mass} at {p}");
+    }
+    for _ in 0..20 {
+        let ctx = ShadingContext::at(rng.point(12.0));
+        let total: f64 = (0..80)
+            .map(|e| glt.pmf_exact(&ctx, LightId::Emitter(e)))
+            .sum();
+        assert!((total - 1.0).abs() < 1e-5, "{total}");
+        assert_eq!(glt.pmf(&ctx, LightId::Environment), 0.0);
+        for _ in 0..50 {
+            let s = glt.sample(&ctx, rng.f()).unwrap();
+            assert_eq!(s.pmf.to_bits(), glt.pmf(&ctx, s.light).to_bits());
+            let (light, p) = glt.sample_exact(&ctx, rng.f64()).unwrap();
+            assert_eq!(p.to_bits(), glt.pmf_exact(&ctx, light).to_bits());
+        }
+    }
+    assert!(!glt.is_empty());
+}
+
+/// When a cell splits, both halves start from a copy of its cut and
+/// statistics, so before any new data they sample identically.
+#[test]
+fn split_cells_inherit_the_cut() {
+    let lights = two_rooms();
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let config = GltConfig {
+        spatial_threshold: 100.0,
+        ..GltConfig::default()
+    };
+    let mut glt = Glt::new(&tree, scene(), config).unwrap();
+    // All splats in one corner, all for light 3: the root cell splits; its
+    // halves refine from the same sums.
+    let p = Vec3::new(-9.0, -9.0, -9.0);
+    let far = ShadingContext::at(Vec3::new(9.0, 9.0, 9.0));
+    for _ in 0..1000 {
+        glt.splat_at(p, LightId::Emitter(3), 2.0);
+    }
+    glt.refine();
+    let cells = glt.spatial().cell_count();
+    assert!(cells >= 2, "{cells}");
+    let first = glt.spatial().data_slice()[0].cut().nodes().to_vec();
+    assert!(first.len() > 1);
+    for cell in glt.spatial().data_slice() {
+        assert_eq!(cell.cut().nodes(), &first[..]);
+        assert_eq!(cell.splats(), 0);
+    }
+    let near = ShadingContext::at(p);
+    let p3 = glt.pmf_exact(&near, LightId::Emitter(3));
+    assert_eq!(
+        p3.to_bits(),
+        glt.pmf_exact(&far, LightId::Emitter(3)).to_bits()
+    );
+    // A second round in the corner: that cell learns light 3 alone, the far
+    // one (no data) keeps its cut.
+    for _ in 0..1000 {
+        glt.splat_at(p, LightId::Emitter(3), 2.0);
+    }
+    glt.refine();
+    let alpha = glt.config().cut.alpha;
+    assert!(glt.pmf_exact(&near, LightId::Emitter(3)) > 1.0 - alpha);
+    assert_eq!(
+        glt.pmf_exact(&far, LightId::Emitter(3)).to_bits(),
+        p3.to_bits()
+    );
+}
+
+/// The stochastic box: splats near a cell border land on both sides, in
+/// proportion to the overlap of the +-1/2-cell box with each; the
+/// deterministic variant never crosses.
+#[test]
+fn jitter_spreads_over_neighbouring_cells() {
+    let lights = two_rooms();
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let config = GltConfig {
+        spatial_threshold: 10.0,
+        ..GltConfig::default()
+    };
+    let mut glt = Glt::new(&tree, scene(), config).unwrap();
+    // Split the root once: cells meet at x = 0 (the cube is about [-10, 10]).
+    for _ in 0..15 {
+        glt.splat_at(Vec3::ZERO, LightId::Emitter(0), 1.0);
+    }
+    glt.refine();
+    assert_eq!(glt.spatial().cell_count(), 2);
+    let side = glt
+        .spatial()
+        .cell_bounds(glt.locate(Vec3::new(-1.0, 0.0, 0.0)).unwrap())
+        .diagonal()
+        .x;
+    let p = Vec3::new(-0.25 * side, 0.0, 0.0);
+    let here = glt.locate(p).unwrap();
+    let mut rng = Rand::new(3);
+    for _ in 0..4000 {
+        glt.splat(p, LightId::Emitter(1), 1.0, &mut rng.0);
+    }
+    let counts: Vec<u64> = glt
+        .spatial()
+        .data_slice()
+        .iter()
+        .map(|c| c.splats())
+        .collect();
+    let other = 1 - here.index();
+    // A box of one cell width centred a quarter cell from the border
+    // overlaps the neighbour by a quarter.
+    let share = counts[other] as f64 / 4000.0;
+    assert!((share - 0.25).abs() < 0.03, "{counts:?}");
+    for _ in 0..100 {
+        glt.splat_at(p, LightId::Emitter(1), 1.0);
+    }
+    let after: Vec<u64> = glt
+        .spatial()
+        .data_slice()
+        .iter()
+        .map(|c| c.splats())
+        .collect();
+    assert_eq!(after[other], counts[other]);
+    assert_eq!(after[here.index()], counts[here.index()] + 100);
+}
+
+/// Bad input is dropped and counted, never recorded: non-finite or
+/// negative values, non-finite positions, emitters out of range or with
+/// zero power, the environment when none is configured.
+#[test]
+fn bad_splats_are_counted() {
+    let mut lights = two_rooms();
+    lights[5].power = 0.0;
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let glt = Glt::new(&tree, scene(), GltConfig::default()).unwrap();
+    let mut rng = Rand::new(5);
+    let p = Vec3::ONE;
+    let bad = [
+        (p, LightId::Emitter(1), f32::NAN),
+        (p, LightId::Emitter(1), -2.0),
+        (p, LightId::Emitter(1), f32::INFINITY),
+        (Vec3::new(f32::NAN, 0.0, 0.0), LightId::Emitter(1), 1.0),
+        (p, LightId::Emitter(80), 1.0),
+        (p, LightId::Emitter(u32::MAX), 1.0),
+        (p, LightId::Emitter(5), 1.0),
+        (p, LightId::Environment, 1.0),
+    ];
+    for (i, &(q, light, v)) in bad.iter().enumerate() {
+        assert_eq!(glt.splat(q, light, v, &mut rng.0), SplatOutcome::Dropped);
+        assert_eq!(glt.splat_at(q, light, v), SplatOutcome::Dropped);
+        assert_eq!(glt.dropped_splats(), 2 * (i as u64 + 1));
+    }
+    assert_eq!(
+        glt.splat_at(p, LightId::Emitter(1), 0.0),
+        SplatOutcome::Zero
+    );
+    assert_eq!(
+        glt.splat_at(p, LightId::Emitter(1), 1.0),
+        SplatOutcome::Recorded
+    );
+    assert_eq!(glt.dropped_splats(), 16);
+    let (emitters, env) = glt.cut_at(p).unwrap().accumulated();
+    assert_eq!((emitters, env), (1.0, 0.0));
+    assert_eq!(glt.spatial().data_slice()[0].splats(), 2);
+    // Queries at non-finite points: nothing, consistently.
+    let nan = ShadingContext::at(Vec3::splat(f32::NAN));
+    assert!(glt.sample(&nan, 0.5).is_none());
+    assert_eq!(glt.pmf(&nan, LightId::Emitter(0)), 0.0);
+}
+
+/// The environment light: learned per cell beside the cut, with the prior
+/// floor; the pmf still sums to one.
+#[test]
+fn environment_fraction_is_learned() {
+    let lights = two_rooms();
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let config = GltConfig {
+        cut: CutConfig {
+            environment: Some(0.3),
+            ..CutConfig::default()
+        },
+        ..GltConfig::default()
+    };
+    let mut glt = Glt::new(&tree, scene(), config).unwrap();
+    let ctx = ShadingContext::at(Vec3::ZERO);
+    assert!((glt.pmf_exact(&ctx, LightId::Environment) - 0.3).abs() < 1e-7);
+    for _ in 0..100 {
+        glt.splat_at(Vec3::ZERO, LightId::Environment, 3.0);
+        glt.splat_at(Vec3::ZERO, LightId::Emitter(7), 1.0);
+    }
+    glt.refine();
+    // (1 - alpha) * 3/4 + alpha * 0.3
+    let alpha = glt.config().cut.alpha;
+    let expect = (1.0 - alpha) * 0.75 + alpha * 0.3;
+    let env = glt.pmf_exact(&ctx, LightId::Environment);
+    assert!((env - expect).abs() < 1e-6, "{env}");
+    let total: f64 = env
+        + (0..80)
+            .map(|e| glt.pmf_exact(&ctx, LightId::Emitter(e)))
+            .sum::<f64>();
+    assert!((total - 1.0).abs() < 1e-6);
+    let mut rng = Rand::new(9);
+    let mut hits = 0;
+    for _ in 0..20_000 {
+        let s = glt.sample(&ctx, rng.f()).unwrap();
+        assert_eq!(s.pmf, glt.pmf(&ctx, s.light));
+        hits += (s.light == LightId::Environment) as u32;
+    }
+    assert!((hits as f64 / 20_000.0 - expect).abs() < 0.02);
+}
+
+/// Jitter-free splats from four threads equal a serial run: bit for bit in
+/// deterministic mode, including the spatial splits and cell counts.
+#[test]
+fn threads_equal_serial() {
+    let lights = two_rooms();
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let config = GltConfig {
+        cut: CutConfig {
+            accumulation: Accumulation::Deterministic,
+            ..CutConfig::default()
+        },
+        spatial_threshold: 300.0,
+        ..GltConfig::default()
+    };
+    let mut rng = Rand::new(12);
+    let stream: Vec<(Vec3, u32, f32)> = (0..24_000)
+        .map(|_| {
+            let p = rng.point(9.5);
+            let e = (rng.f() * 80.0) as u32;
+            (p, e, value(&lights, e, p) * rng.range(0.5, 1.5))
+        })
+        .collect();
+    let mut serial = Glt::new(&tree, scene(), config).unwrap();
+    let mut parallel = Glt::new(&tree, scene(), config).unwrap();
+    for chunk in stream.chunks(8000) {
+        for &(p, e, v) in chunk {
+            serial.splat_at(p, LightId::Emitter(e), v);
+        }
+        std::thread::scope(|s| {
+            for t in 0..4 {
+                let glt = &parallel;
+                s.spawn(move || {
+                    for &(p, e, v) in chunk.iter().skip(t).step_by(4) {
+                        glt.splat_at(p, LightId::Emitter(e), v);
+                    }
+                });
+            }
+        });
+        serial.refine();
+        parallel.refine();
+        let (a, b) = (
+            serial.spatial().data_slice(),
+            parallel.spatial().data_slice(),
+        );
+        assert_eq!(a.len(), b.len());
+        for (x, y) in a.iter().zip(b) {
+            let (x, y): (&[u8], &[u8]) = (
+                bytemuck::cast_slice(x.cut().nodes()),
+                bytemuck::cast_slice(y.cut().nodes()),
+            );
+            assert_eq!(x, y);
+        }
+    }
+    assert!(serial.spatial().cell_count() > 4);
+}
+
+/// The memory report: 12 bytes per cut node, parts add up to the total.
+#[test]
+fn memory_report_adds_up() {
+    let lights = two_rooms();
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let mut glt = Glt::new(&tree, scene(), small_config()).unwrap();
+    let mut rng = Rand::new(2);
+    train(&mut glt, &lights, &mut rng, 3, 4000);
+    let m = glt.memory();
+    assert_eq!(GltMemory::BYTES_PER_CUT_NODE, 12);
+    assert_eq!(m.cells, glt.spatial().cell_count());
+    let nodes: usize = glt
+        .spatial()
+        .data_slice()
+        .iter()
+        .map(|c| c.cut().nodes().len())
+        .sum();
+    assert_eq!(m.cuts.nodes, nodes);
+    assert_eq!(m.cuts.node_bytes, 12 * nodes);
+    assert_eq!(m.cuts.sum_bytes, 8 * (2 * nodes + m.cells));
+    assert_eq!(m.spatial_bytes, glt.spatial().bytes());
+    assert_eq!(m.shared_bytes, 4 * tree.node_count());
+    assert_eq!(
+        m.total(),
+        m.spatial_bytes + m.shared_bytes + m.cuts.node_bytes + m.cuts.sum_bytes
+    );
+    assert!(m.bytes_per_cell() > 0.0);
+}
