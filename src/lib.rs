@@ -53,6 +53,7 @@
 extern crate alloc;
 
 pub mod emitter;
+pub mod field;
 pub mod glt;
 pub mod light_sampler;
 pub mod light_tree;
