@@ -8,8 +8,10 @@
 
 use super::hierarchy::NodeBounds;
 use crate::math::scalar::{ceil, floor};
-use crate::math::{Aabb, LightCone};
+use crate::math::{Aabb, LightCone, cone_angle_between};
 use bytemuck::{Pod, Zeroable};
+use core::cmp::Ordering;
+use core::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
 /// Link bit marking a leaf; the other 31 bits hold the emitter.
@@ -47,28 +49,39 @@ pub struct LightNode {
 
 const _: () = assert!(core::mem::size_of::<LightNode>() == 32);
 
+/// Exact (unquantised) data of one node, as the builder computes it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct NodeData {
+    /// Bounds of every emitter below.
+    pub bounds: Aabb,
+    /// Unit axis of the normal cone (ignored for a sphere).
+    pub axis: Vec3,
+    /// Half-angle of the normal cone in radians; `>= pi` is the sphere.
+    pub theta_o: f32,
+    /// Cosine of the widest emission angle below.
+    pub cos_theta_e: f32,
+    /// Whether any emitter below is two-sided.
+    pub two_sided: bool,
+    /// Total power below.
+    pub energy: f32,
+    /// Right child, or `LEAF_BIT | emitter`.
+    pub link: u32,
+    /// Parent, or `NO_PARENT`.
+    pub parent: u32,
+}
+
 impl LightNode {
     /// Encodes exact node data against the scene box `scene`.
-    pub(crate) fn encode(
-        scene: &Aabb,
-        bounds: &Aabb,
-        cone: &LightCone,
-        two_sided: bool,
-        energy: f32,
-        link: u32,
-        parent: u32,
-    ) -> Self {
-        let (axis, cone) = encode_cone(cone);
+    pub(crate) fn encode(scene: &Aabb, d: &NodeData) -> Self {
+        let (axis, cos_theta_o) = encode_cone(d.axis, d.theta_o);
         Self {
-            bounds: quantize_bounds(scene, bounds),
-            cos_theta_o: (floor((cone.cos_theta_o.clamp(-1.0, 1.0) + 1.0) * 0.5 * QMAX)) as u16,
-            cos_theta_e: (floor((cone.cos_theta_e.clamp(-1.0, 1.0) + 1.0) * 0.5 * COS_E_MAX))
-                as u16
-                | if two_sided { TWO_SIDED_BIT } else { 0 },
+            bounds: quantize_bounds(scene, &d.bounds),
+            cos_theta_o,
+            cos_theta_e: encode_cos_e(d.cos_theta_e) | if d.two_sided { TWO_SIDED_BIT } else { 0 },
             axis,
-            energy: energy.to_bits(),
-            link,
-            parent,
+            energy: d.energy.to_bits(),
+            link: d.link,
+            parent: d.parent,
         }
     }
 
@@ -97,16 +110,24 @@ impl LightNode {
     /// Decodes the node's (conservative) bounds against the scene box.
     #[inline]
     pub(crate) fn decode(&self, scene: &Aabb) -> NodeBounds {
-        let ext = scene.diagonal() / QMAX;
-        let q = |i: usize| self.bounds[i] as f32;
-        let min = scene.min + Vec3::new(q(0), q(1), q(2)) * ext;
-        let max = scene.min + Vec3::new(q(3), q(4), q(5)) * ext;
+        let b = &self.bounds;
+        let (lo, hi) = (scene.min, scene.max);
+        let min = Vec3::new(
+            dequantize(lo.x, hi.x, b[0]),
+            dequantize(lo.y, hi.y, b[1]),
+            dequantize(lo.z, hi.z, b[2]),
+        );
+        let max = Vec3::new(
+            dequantize(lo.x, hi.x, b[3]),
+            dequantize(lo.y, hi.y, b[4]),
+            dequantize(lo.z, hi.z, b[5]),
+        );
         NodeBounds {
             bounds: Aabb { min, max },
             cone: LightCone {
                 axis: decode_octahedral(self.axis),
-                cos_theta_o: self.cos_theta_o as f32 / QMAX * 2.0 - 1.0,
-                cos_theta_e: (self.cos_theta_e & !TWO_SIDED_BIT) as f32 / COS_E_MAX * 2.0 - 1.0,
+                cos_theta_o: decode_cos_o(self.cos_theta_o),
+                cos_theta_e: decode_cos_e(self.cos_theta_e & !TWO_SIDED_BIT),
             },
             two_sided: self.cos_theta_e & TWO_SIDED_BIT != 0,
             energy: self.energy(),
@@ -114,54 +135,90 @@ impl LightNode {
     }
 }
 
-/// Quantises `b` inside `scene`, rounding outward and checking the decoded
-/// value so float rounding can never shrink the box.
+/// The coordinate of grid step `q` between `lo` and `hi`: a convex
+/// combination, so it never overflows for finite corners (a difference
+/// `hi - lo` could) and is exactly `lo` at 0 and exactly `hi` at `QMAX`.
+#[inline]
+fn dequantize(lo: f32, hi: f32, q: u16) -> f32 {
+    let t = q as f32 * (1.0 / QMAX);
+    lo * (1.0 - t) + hi * t
+}
+
+#[inline]
+fn decode_cos_o(q: u16) -> f32 {
+    q as f32 / QMAX * 2.0 - 1.0
+}
+
+#[inline]
+fn decode_cos_e(q: u16) -> f32 {
+    q as f32 / COS_E_MAX * 2.0 - 1.0
+}
+
+/// Quantises `b` inside `scene`, rounding outward: from a first guess, each
+/// code moves outward until the decoded value (through [`dequantize`]
+/// itself, so float rounding cannot shrink the box) contains the corner.
 fn quantize_bounds(scene: &Aabb, b: &Aabb) -> [u16; 6] {
-    let ext = scene.diagonal();
-    let step = ext / QMAX;
     let mut q = [0u16; 6];
     for axis in 0..3 {
-        if !(ext[axis] > 0.0) {
-            q[axis] = 0;
-            q[axis + 3] = 0;
+        let (lo, hi) = (scene.min[axis], scene.max[axis]);
+        if hi.partial_cmp(&lo) != Some(Ordering::Greater) {
             continue;
         }
-        let t = |x: f32| (x - scene.min[axis]) / ext[axis] * QMAX;
-        let mut lo = floor(t(b.min[axis])).clamp(0.0, QMAX) as u16;
-        while lo > 0 && scene.min[axis] + lo as f32 * step[axis] > b.min[axis] {
-            lo -= 1;
+        // First guesses in f64, where `hi - lo` cannot overflow.
+        let scale = QMAX as f64 / (hi as f64 - lo as f64);
+        let t = |x: f32| ((x as f64 - lo as f64) * scale).clamp(0.0, QMAX as f64) as f32;
+        let (bmin, bmax) = (b.min[axis], b.max[axis]);
+        // Truncation floors the non-negative guess.
+        let mut qlo = t(bmin) as u16;
+        while qlo > 0 && dequantize(lo, hi, qlo) > bmin {
+            qlo -= 1;
         }
-        let mut hi = ceil(t(b.max[axis])).clamp(0.0, QMAX) as u16;
-        while hi < u16::MAX && scene.min[axis] + hi as f32 * step[axis] < b.max[axis] {
-            hi += 1;
+        let mut qhi = ceil(t(bmax)) as u16;
+        while qhi < u16::MAX && dequantize(lo, hi, qhi) < bmax {
+            qhi += 1;
         }
-        q[axis] = lo;
-        q[axis + 3] = hi;
+        q[axis] = qlo;
+        q[axis + 3] = qhi;
     }
     q
 }
 
-/// Encodes the axis and widens `theta_o` by the encoding's angular error.
-fn encode_cone(cone: &LightCone) -> (u32, LightCone) {
-    if cone.is_sphere() {
-        return (encode_octahedral(Vec3::Z), *cone);
+/// The largest 16-bit code whose decoded cosine is at most `c` (from a
+/// guess at or above it).
+fn encode_cos_o(c: f64) -> u16 {
+    let guess = floor(((c + 1.0) * 0.5 * QMAX as f64) as f32) + 1.0;
+    let mut q = guess.clamp(0.0, QMAX) as u16;
+    while q > 0 && decode_cos_o(q) as f64 > c {
+        q -= 1;
     }
-    let code = encode_octahedral(cone.axis);
-    let err = crate::math::cone_angle_between(cone.axis, decode_octahedral(code));
-    // A small margin for the decode's own float error.
-    let theta_o = cone.theta_o() + err + 1e-5;
-    let widened = if theta_o >= core::f32::consts::PI {
-        LightCone {
-            cos_theta_e: cone.cos_theta_e,
-            ..LightCone::SPHERE
-        }
-    } else {
-        LightCone {
-            cos_theta_o: crate::math::scalar::cos(theta_o),
-            ..*cone
-        }
-    };
-    (code, widened)
+    q
+}
+
+/// The largest 15-bit code whose decoded cosine is at most `c` (from a
+/// guess at or above it).
+fn encode_cos_e(c: f32) -> u16 {
+    let c = c.clamp(-1.0, 1.0);
+    let guess = floor((c + 1.0) * 0.5 * COS_E_MAX) + 1.0;
+    let mut q = guess.clamp(0.0, COS_E_MAX) as u16;
+    while q > 0 && decode_cos_e(q) > c {
+        q -= 1;
+    }
+    q
+}
+
+/// Encodes the axis, then `theta_o` widened by the axis encoding's angular
+/// error (and a margin for float error), as a cosine rounded down.
+fn encode_cone(axis: Vec3, theta_o: f32) -> (u32, u16) {
+    if theta_o.partial_cmp(&PI) != Some(Ordering::Less) {
+        return (encode_octahedral(Vec3::Z), 0);
+    }
+    let code = encode_octahedral(axis);
+    let err = cone_angle_between(axis, decode_octahedral(code));
+    let theta = theta_o.max(0.0) as f64 + err as f64 + 1e-5;
+    if theta >= core::f64::consts::PI {
+        return (code, 0);
+    }
+    (code, encode_cos_o(libm::cos(theta)))
 }
 
 fn encode_octahedral(v: Vec3) -> u32 {
@@ -199,7 +256,23 @@ fn sign_not_zero(p: Vec2) -> Vec2 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::cone_angle_between;
+
+    fn data(bounds: Aabb, cone: &LightCone, two_sided: bool, energy: f32) -> NodeData {
+        NodeData {
+            bounds,
+            axis: cone.axis,
+            theta_o: if cone.is_sphere() { PI } else { cone.theta_o() },
+            cos_theta_e: cone.cos_theta_e,
+            two_sided,
+            energy,
+            link: 0,
+            parent: 0,
+        }
+    }
+
+    fn encode(scene: &Aabb, b: &Aabb, cone: &LightCone, two_sided: bool) -> NodeBounds {
+        LightNode::encode(scene, &data(*b, cone, two_sided, 2.0)).decode(scene)
+    }
 
     #[test]
     fn bounds_round_outward() {
@@ -208,8 +281,7 @@ mod tests {
             let f = i as f32 / 199.0;
             let lo = scene.min + scene.diagonal() * f * 0.7;
             let b = Aabb::new(lo, lo + scene.diagonal() * 0.123 * (1.0 - f));
-            let n = LightNode::encode(&scene, &b, &LightCone::SPHERE, false, 1.0, 0, 0);
-            let d = n.decode(&scene).bounds;
+            let d = encode(&scene, &b, &LightCone::SPHERE, false).bounds;
             assert!(
                 d.min.cmple(b.min).all() && d.max.cmpge(b.max).all(),
                 "{b:?} -> {d:?}"
@@ -220,19 +292,55 @@ mod tests {
     }
 
     #[test]
+    fn scene_box_decodes_exactly() {
+        // The root's box must decode to itself: the top code is exactly the
+        // scene's upper corner, whatever the rounding of `hi - lo`.
+        for scene in [
+            Aabb::new(
+                Vec3::new(-51.948204, -52.036892, -52.17461),
+                Vec3::new(52.057804, 51.75599, 52.51436),
+            ),
+            Aabb::new(Vec3::splat(-3e38), Vec3::splat(3.4e38)),
+            Aabb::new(Vec3::splat(1e-40), Vec3::splat(3e-40)),
+        ] {
+            let d = encode(&scene, &scene, &LightCone::SPHERE, false).bounds;
+            assert_eq!(d, scene);
+        }
+    }
+
+    #[test]
+    fn huge_scenes_never_decode_to_nan() {
+        let scene = Aabb::new(Vec3::splat(-f32::MAX), Vec3::splat(f32::MAX));
+        for i in 0..100 {
+            let x = f32::MAX * (i as f32 / 50.0 - 1.0);
+            let b = Aabb::new(Vec3::splat(x), Vec3::splat(x * 0.5));
+            let d = encode(&scene, &b, &LightCone::SPHERE, false).bounds;
+            assert!(!d.min.is_nan() && !d.max.is_nan());
+            assert!(
+                d.min.cmple(b.min).all() && d.max.cmpge(b.max).all(),
+                "{b:?} -> {d:?}"
+            );
+        }
+    }
+
+    #[test]
     fn cone_widens_by_axis_error() {
         let scene = Aabb::new(Vec3::ZERO, Vec3::ONE);
         for i in 0..500 {
             let t = i as f32 * 0.731;
             let axis = Vec3::new(t.cos(), (t * 1.7).sin(), (t * 0.3).cos() - 0.5).normalize();
             let cone = LightCone::new(axis, 0.01 * (i % 7) as f32, 1.2);
-            let n = LightNode::encode(&scene, &scene, &cone, i % 2 == 0, 2.0, 0, 0);
-            let d = n.decode(&scene);
+            let d = encode(&scene, &scene, &cone, i % 2 == 0);
             assert_eq!(d.two_sided, i % 2 == 0);
             assert!(d.cone.cos_theta_o <= cone.cos_theta_o);
             assert!(d.cone.cos_theta_e <= cone.cos_theta_e);
-            // The true axis lies inside the decoded cone.
-            assert!(cone_angle_between(axis, d.cone.axis) <= d.cone.theta_o());
+            // The true axis lies inside the decoded cone, even for a cone of
+            // angle 0 (whose cosine 1 has no room to round down in f32).
+            let need = cone_angle_between(axis, d.cone.axis) as f64 + cone.theta_o() as f64;
+            assert!(
+                need <= libm::acos(d.cone.cos_theta_o as f64),
+                "{cone:?} -> {d:?}"
+            );
             assert_eq!(d.energy, 2.0);
         }
     }
@@ -240,15 +348,20 @@ mod tests {
     #[test]
     fn sphere_stays_sphere() {
         let scene = Aabb::new(Vec3::ZERO, Vec3::ONE);
-        let n = LightNode::encode(&scene, &scene, &LightCone::SPHERE, false, 1.0, 0, 0);
-        assert!(n.decode(&scene).cone.is_sphere());
+        assert!(
+            encode(&scene, &scene, &LightCone::SPHERE, false)
+                .cone
+                .is_sphere()
+        );
+        let wide = LightCone::new(Vec3::X, PI - 1e-6, 1.0);
+        assert!(encode(&scene, &scene, &wide, false).cone.is_sphere());
     }
 
     #[test]
     fn flat_scene_axis_decodes_to_scene() {
         let scene = Aabb::new(Vec3::new(0.0, 5.0, 0.0), Vec3::new(1.0, 5.0, 1.0));
         let b = Aabb::from_point(Vec3::new(0.5, 5.0, 0.5));
-        let d = LightNode::encode(&scene, &b, &LightCone::SPHERE, false, 1.0, 0, 0).decode(&scene);
+        let d = encode(&scene, &b, &LightCone::SPHERE, false);
         assert_eq!(d.bounds.min.y, 5.0);
         assert_eq!(d.bounds.max.y, 5.0);
     }

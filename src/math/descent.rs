@@ -160,9 +160,9 @@ mod tests {
 
     #[test]
     fn follows_inverse_cdf_of_two_leaves() {
-        let mut d = Descent::new(0.2);
+        let mut d = Descent::from_f64(0.2);
         assert_eq!(d.choose(1.0, 3.0), Some(Side::Left));
-        assert!((d.u() - 0.8).abs() < 1e-12);
+        assert!((d.u() - 0.8).abs() < 1e-15);
         assert_eq!(d.pmf(), 0.25);
         let mut d = Descent::new(0.25);
         assert_eq!(d.choose(1.0, 3.0), Some(Side::Right));
@@ -184,9 +184,9 @@ mod tests {
     #[test]
     fn sixty_four_halvings_keep_entropy() {
         // A chain where every node sends half of the mass right: the leaf at
-        // depth k has probability 2^-(k+1). u = 2^-40 must walk left 39 times
-        // and then reach the leaf whose interval holds it.
-        let u = 2f64.powi(-40) * 1.5;
+        // depth k has probability 2^-(k+1) and owns [2^-(k+1), 2^-k). u in
+        // [2^-41, 2^-40) walks left 40 times, then right.
+        let u = 2f64.powi(-41) * 1.5;
         let mut d = Descent::from_f64(u);
         let mut depth = 0;
         while d.choose(1.0, 1.0) == Some(Side::Left) {
