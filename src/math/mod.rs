@@ -4,6 +4,7 @@
 
 mod aabb;
 mod cone;
+mod counter;
 mod descent;
 pub(crate) mod scalar;
 mod sphere_map;
@@ -11,6 +12,7 @@ mod sum;
 
 pub use aabb::Aabb;
 pub use cone::LightCone;
+pub use counter::Counter;
 pub(crate) use cone::angle_between as cone_angle_between;
 pub(crate) use descent::pmf_to_f32;
 pub use descent::{Descent, Side};
