@@ -10,12 +10,13 @@ use super::splat::SplatOutcome;
 use crate::emitter::ShadingContext;
 use crate::light_sampler::{LightId, LightSample, LightSampler};
 use crate::light_tree::LightHierarchy;
-use crate::math::Aabb;
 use crate::math::pmf_to_f32;
-use crate::math::scalar::sqrt64;
-use crate::spatial::{BinaryTree, CellId, SpatialError, SpatialTree};
-use core::sync::atomic::{AtomicU64, Ordering::Relaxed};
+use crate::math::{Aabb, Counter};
+use crate::spatial::{
+    BinaryTree, CellId, SpatialError, SpatialFilter, SpatialTree, jitter_u64, split_threshold,
+};
 use glam::Vec3;
+use rand_core::Rng;
 
 /// Parameters of a [`Glt`]: the cuts' and the spatial tree's.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -44,18 +45,19 @@ impl Default for GltConfig {
 
 /// What a cell of a [`Glt`] holds: its cut and the number of splats it
 /// received this iteration (for spatial refinement).
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct GltCell {
     cut: GuidingCut,
-    splats: AtomicU64,
+    splats: Counter,
+    /// The count the spatial split rule sees during `refine` (halved at
+    /// each split).
+    split_count: u64,
 }
 
-impl Clone for GltCell {
-    fn clone(&self) -> Self {
-        Self {
-            cut: self.cut.clone(),
-            splats: AtomicU64::new(self.splats.load(Relaxed)),
-        }
+impl AsRef<GuidingCut> for GltCell {
+    #[inline]
+    fn as_ref(&self) -> &GuidingCut {
+        &self.cut
     }
 }
 
@@ -69,7 +71,7 @@ impl GltCell {
     /// Splats (zero values included) received since the last refinement.
     #[inline]
     pub fn splats(&self) -> u64 {
-        self.splats.load(Relaxed)
+        self.splats.get()
     }
 }
 
@@ -118,7 +120,7 @@ pub struct Glt<'a, H: LightHierarchy + ?Sized> {
     config: GltConfig,
     spatial: BinaryTree<GltCell>,
     iteration: u32,
-    dropped: AtomicU64,
+    dropped: Counter,
 }
 
 impl<'a, H: LightHierarchy + ?Sized> Glt<'a, H> {
@@ -135,14 +137,15 @@ impl<'a, H: LightHierarchy + ?Sized> Glt<'a, H> {
         let guide = GuidingTree::new(tree, config.cut);
         let cell = GltCell {
             cut: guide.new_cut(),
-            splats: AtomicU64::new(0),
+            splats: Counter::new(),
+            split_count: 0,
         };
         Ok(Self {
             guide,
             config,
             spatial: BinaryTree::new(scene, cell)?,
             iteration: 0,
-            dropped: AtomicU64::new(0),
+            dropped: Counter::new(),
         })
     }
 
@@ -182,7 +185,7 @@ impl<'a, H: LightHierarchy + ?Sized> Glt<'a, H> {
     /// values or positions, emitters out of range or with zero power, the
     /// environment when none is configured.
     pub fn dropped_splats(&self) -> u64 {
-        self.dropped.load(Relaxed)
+        self.dropped.get()
     }
 
     /// Chooses a light at `ctx` from an `f64` number (53 bits), with the
@@ -201,49 +204,59 @@ impl<'a, H: LightHierarchy + ?Sized> Glt<'a, H> {
 
     /// Records a direct-light estimate `value` for `light` seen from `p` (see
     /// [`GuidingTree::splat`] for what the value is). `p` is first jittered
-    /// uniformly inside a box the size of its cell centred on it (PPG's
+    /// uniformly inside a box the size of its cell centred on it (on it
+    /// clamped onto the spatial tree's cube, for points outside; PPG's
     /// stochastic box filter, +-1/2 cell per axis; the paper's code uses
     /// +-1/4), which spreads each sample over the neighbouring cells in
     /// proportion to their overlap with that box, so adjacent cells learn
     /// similar cuts and no seams appear at cell borders. One `next_u64` of
     /// `rng` per call. `&self`: any number of threads at once.
-    pub fn splat<R: rand_core::Rng + ?Sized>(
+    pub fn splat<R: Rng + ?Sized>(
         &self,
         p: Vec3,
         light: LightId,
         value: f32,
         rng: &mut R,
     ) -> SplatOutcome {
-        let Some((_, bounds)) = self.spatial.locate_with_bounds(p) else {
-            return self.reject();
-        };
-        let bits = rng.next_u64();
-        let unit = |k: u32| ((bits >> (k * 21)) & 0x1f_ffff) as f32 * (1.0 / 2_097_152.0) - 0.5;
-        let jitter = Vec3::new(unit(0), unit(1), unit(2)) * bounds.diagonal();
-        self.splat_at(p + jitter, light, value)
+        self.splat_filtered(p, light, value, SpatialFilter::StochasticBox, || {
+            jitter_u64(rng)
+        })
     }
 
     /// Like [`Glt::splat`] without jitter: the estimate goes to the cell
     /// holding `p` (deterministic; nearest-cell filtering).
     pub fn splat_at(&self, p: Vec3, light: LightId, value: f32) -> SplatOutcome {
-        let Some(cell) = self.spatial.locate(p) else {
-            return self.reject();
-        };
-        let cell = self.spatial.data(cell);
-        let outcome = self.guide.splat(&cell.cut, light, value);
-        match outcome {
-            SplatOutcome::Dropped => return self.reject(),
-            SplatOutcome::Recorded | SplatOutcome::Zero => {
-                cell.splats.fetch_add(1, Relaxed);
-            }
+        self.splat_filtered(p, light, value, SpatialFilter::Nearest, || Vec3::ZERO)
+    }
+
+    fn splat_filtered(
+        &self,
+        p: Vec3,
+        light: LightId,
+        value: f32,
+        filter: SpatialFilter,
+        jitter: impl FnOnce() -> Vec3,
+    ) -> SplatOutcome {
+        let at = self.spatial.locate_with_bounds(p);
+        let outcome = self.guide.splat_spread(
+            &self.spatial,
+            (p, at),
+            light,
+            value,
+            (filter, jitter),
+            |cell| {
+                cell.splats.bump();
+            },
+        );
+        if outcome == SplatOutcome::Dropped {
+            self.reject();
         }
         outcome
     }
 
     #[inline]
-    fn reject(&self) -> SplatOutcome {
-        self.dropped.fetch_add(1, Relaxed);
-        SplatOutcome::Dropped
+    fn reject(&self) {
+        self.dropped.bump();
     }
 
     /// Ends an iteration: splits cells that received more than
@@ -251,36 +264,34 @@ impl<'a, H: LightHierarchy + ?Sized> Glt<'a, H> {
     /// sums), refines every cut from its sums (a cell that collected nothing
     /// keeps its cut) and zeroes the sums and counts.
     pub fn refine(&mut self) {
-        // c * sqrt(2^k); 2^k by doubling (no `powi` without std), infinite
-        // (no more splits) past f64's range.
-        let two_k = (0..self.iteration.min(1100)).fold(1.0f64, |x, _| x * 2.0);
-        let threshold = self.config.spatial_threshold * sqrt64(two_k);
-        self.spatial.refine_with_heap(
-            |cell, _| cell.splats.load(Relaxed) as f64 > threshold,
-            |cell| {
-                let half = *cell.splats.get_mut() / 2;
-                *cell.splats.get_mut() = half;
-                cell.clone()
-            },
+        for cell in self.spatial.data_slice_mut() {
+            cell.split_count = cell.splats.get();
+        }
+        self.spatial.split_by_weight(
+            split_threshold(self.config.spatial_threshold, self.iteration),
+            |cell| cell.split_count as f64,
+            |cell| cell.split_count /= 2,
             |cell| cell.cut.heap_bytes(),
             self.config.spatial_budget,
         );
         for cell in self.spatial.data_slice_mut() {
             self.guide.refine(&mut cell.cut);
-            *cell.splats.get_mut() = 0;
+            cell.splats.reset();
+            cell.split_count = 0;
         }
         self.iteration = self.iteration.saturating_add(1);
     }
 
     /// Bytes used, by part.
     pub fn memory(&self) -> GltMemory {
-        let mut cuts = CutMemory::default();
-        for cell in self.spatial.data_slice() {
-            cuts += cell.cut.memory();
-        }
         GltMemory {
             cells: self.spatial.cell_count(),
-            cuts,
+            cuts: self
+                .spatial
+                .data_slice()
+                .iter()
+                .map(|c| c.cut.memory())
+                .sum(),
             spatial_bytes: self.spatial.bytes(),
             shared_bytes: self.guide.bytes(),
         }
@@ -289,6 +300,57 @@ impl<'a, H: LightHierarchy + ?Sized> Glt<'a, H> {
     /// The cell holding `p`, `None` for a non-finite point.
     pub fn locate(&self, p: Vec3) -> Option<CellId> {
         self.spatial.locate(p)
+    }
+}
+
+impl core::iter::Sum for CutMemory {
+    fn sum<I: Iterator<Item = Self>>(iter: I) -> Self {
+        iter.fold(Self::default(), |mut a, b| {
+            a += b;
+            a
+        })
+    }
+}
+
+impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
+    /// Records the direct-light estimate `value` for `light` made at a point
+    /// into the cuts of the cells of `cells` that `filter` spreads the point
+    /// over (each cell's part `value * weight`), through
+    /// [`GuidingTree::splat`]. `at` is the point and its
+    /// `locate_with_bounds` (`None` for a non-finite point: dropped);
+    /// `jitter` is that of [`BinaryTree::spread_from`]. `accepted` is called for every cell whose cut took its part
+    /// ([`SplatOutcome::Recorded`] or [`SplatOutcome::Zero`]). The caller
+    /// counts a [`SplatOutcome::Dropped`] result, once per call.
+    ///
+    /// Shared by [`Glt`] and the combined guiding field
+    /// ([`crate::field`]).
+    #[inline]
+    pub(crate) fn splat_spread<C: AsRef<GuidingCut>>(
+        &self,
+        cells: &BinaryTree<C>,
+        (p, at): (Vec3, Option<(CellId, Aabb)>),
+        light: LightId,
+        value: f32,
+        (filter, jitter): (SpatialFilter, impl FnOnce() -> Vec3),
+        accepted: impl Fn(&C),
+    ) -> SplatOutcome {
+        let Some(at) = at else {
+            return SplatOutcome::Dropped;
+        };
+        let mut outcome = SplatOutcome::Zero;
+        cells.spread_from(p, at, filter, jitter, |cell, weight| {
+            let cell = cells.data(cell);
+            match self.splat(cell.as_ref(), light, value * weight) {
+                SplatOutcome::Dropped => outcome = SplatOutcome::Dropped,
+                o => {
+                    accepted(cell);
+                    if o == SplatOutcome::Recorded && outcome != SplatOutcome::Dropped {
+                        outcome = o;
+                    }
+                }
+            }
+        });
+        outcome
     }
 }
 

@@ -12,8 +12,8 @@ mod sum;
 
 pub use aabb::Aabb;
 pub use cone::LightCone;
-pub use counter::Counter;
 pub(crate) use cone::angle_between as cone_angle_between;
+pub use counter::Counter;
 pub(crate) use descent::pmf_to_f32;
 pub use descent::{Descent, Side};
 pub use sphere_map::{SPHERE_MAP_JACOBIAN, canonical_to_dir, dir_to_canonical};

@@ -1,27 +1,8 @@
-//! SD-tree parameters and the spatial splat filters.
+//! SD-tree parameters.
 
 use crate::math::Accumulation;
 use crate::quadtree::{DirectionalFilter, QuadtreeConfig};
-
-/// How a splat is spread over spatial cells.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum SpatialFilter {
-    /// All of it goes to the cell containing the position.
-    #[default]
-    Nearest,
-    /// The position is jittered uniformly within a box the size of the cell
-    /// containing it (`+-1/2` cell per axis, random bits from the caller's
-    /// `rand_core::Rng`), then the cell containing the jittered position
-    /// (clamped to the root) takes all of it. Same cost as `Nearest`, the
-    /// box filter in expectation.
-    StochasticBox,
-    /// The cell-sized box centred on the position is intersected with every
-    /// cell it overlaps; each gets the fraction of the box's volume it
-    /// covers, of both the value and the statistical weight. The box is
-    /// clipped to the root first, so the fractions always sum to 1 (PPG
-    /// loses the part outside the scene).
-    Box,
-}
+use crate::spatial::SpatialFilter;
 
 /// Everything an [`SdTree`](super::SdTree) is configured with. `Default` is
 /// PPG's paper setup; [`SdTreeConfig::improved`] the later recommendations.
@@ -102,23 +83,7 @@ impl SdTreeConfig {
         } else {
             0.0
         };
-        // sqrt(2^k) = 2^(k/2): halve k, with sqrt(2) for odd k.
-        let half = k / 2;
-        let even = if half >= 1024 {
-            f64::INFINITY
-        } else {
-            let mut v = 1.0f64;
-            for _ in 0..half {
-                v *= 2.0;
-            }
-            v
-        };
-        let odd = if k % 2 == 1 {
-            core::f64::consts::SQRT_2
-        } else {
-            1.0
-        };
-        c * even * odd
+        crate::spatial::split_threshold(c, k)
     }
 
     /// `bsdf_fraction` as used: in `[0, 1]`, NaN as 0.5.

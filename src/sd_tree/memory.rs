@@ -1,6 +1,6 @@
 //! How much memory an SD-tree uses.
 
-use super::SdTree;
+use super::{SdCell, SdTree};
 use crate::spatial::BinaryTree;
 
 /// Bytes and node counts of an [`SdTree`]. `total()` is what
@@ -30,24 +30,27 @@ impl SdTreeMemory {
     pub fn total(&self) -> usize {
         self.spatial_bytes + self.quadtree_bytes + self.statistics_bytes
     }
+
+    /// The report for a spatial tree of cells holding [`SdCell`]s (the
+    /// inline size of the whole cell type counts as spatial bytes).
+    pub(crate) fn of<C: AsRef<SdCell>>(tree: &BinaryTree<C>) -> Self {
+        let cells = || tree.data_slice().iter().map(AsRef::as_ref);
+        Self {
+            spatial_nodes: tree.node_count(),
+            cells: tree.data_slice().len(),
+            spatial_bytes: tree.bytes(),
+            quadtree_nodes: cells().map(|c| c.directions.node_count()).sum(),
+            quadtree_building_nodes: cells().map(|c| c.directions.building_node_count()).sum(),
+            quadtree_bytes: cells().map(|c| c.quadtree_heap_bytes()).sum(),
+            statistics_bytes: cells().map(|c| c.stats.bytes()).sum(),
+        }
+    }
 }
 
 impl SdTree {
     /// Bytes and node counts, per structure.
     pub fn memory(&self) -> SdTreeMemory {
-        let cells = self.tree.data_slice();
-        SdTreeMemory {
-            spatial_nodes: self.tree.node_count(),
-            cells: cells.len(),
-            spatial_bytes: self.tree.bytes(),
-            quadtree_nodes: cells.iter().map(|c| c.directions.node_count()).sum(),
-            quadtree_building_nodes: cells
-                .iter()
-                .map(|c| c.directions.building_node_count())
-                .sum(),
-            quadtree_bytes: cells.iter().map(|c| c.quadtree_heap_bytes()).sum(),
-            statistics_bytes: cells.iter().map(|c| c.stats.bytes()).sum(),
-        }
+        SdTreeMemory::of(&self.tree)
     }
 
     /// Bytes per spatial node word.

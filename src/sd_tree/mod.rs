@@ -112,41 +112,35 @@ mod memory;
 mod query;
 mod refine;
 mod splat;
+mod state;
 mod validate;
 
+pub use crate::spatial::SpatialFilter;
 pub use cell::SdCell;
-pub use config::{SdTreeConfig, SpatialFilter};
+pub use config::SdTreeConfig;
 pub use dropped::{DropReason, DroppedSplats};
 pub use fraction::{BETA1, BETA2, LEARNING_RATE, THETA_LIMIT};
 pub use memory::SdTreeMemory;
+pub(crate) use state::SdState;
 
 use crate::math::Aabb;
 use crate::spatial::{BinaryTree, SpatialError};
-use dropped::DropCounters;
 
 /// Practical Path Guiding's SD-tree. See the [module docs](self).
 #[derive(Clone, Debug)]
 pub struct SdTree {
     tree: BinaryTree<SdCell>,
-    config: SdTreeConfig,
-    iteration: u32,
-    dropped: DropCounters,
+    state: SdState,
 }
 
 impl SdTree {
     /// One cell over the cube around `scene` (flat and point scenes are
     /// padded), sampling uniformly. Errors for empty or non-finite bounds.
     pub fn new(scene: Aabb, config: SdTreeConfig) -> Result<Self, SpatialError> {
-        let cell = SdCell::new(
-            config.accumulation,
-            config.learn_bsdf_fraction,
-            config.effective_bsdf_fraction(),
-        );
+        let state = SdState::new(config);
         Ok(Self {
-            tree: BinaryTree::new(scene, cell)?,
-            config,
-            iteration: 0,
-            dropped: DropCounters::default(),
+            tree: BinaryTree::new(scene, state.new_cell())?,
+            state,
         })
     }
 
@@ -159,13 +153,13 @@ impl SdTree {
     /// The configuration.
     #[inline]
     pub fn config(&self) -> &SdTreeConfig {
-        &self.config
+        &self.state.config
     }
 
     /// How many refinements were made (the `k` of the next split threshold).
     #[inline]
     pub fn iteration(&self) -> u32 {
-        self.iteration
+        self.state.iteration
     }
 
     /// Number of spatial cells.
@@ -176,11 +170,11 @@ impl SdTree {
 
     /// Splats and fraction records dropped for bad input so far, per reason.
     pub fn dropped_splats(&self) -> DroppedSplats {
-        self.dropped.snapshot()
+        self.state.dropped.snapshot()
     }
 
     /// Sets the dropped-input counters to zero.
     pub fn reset_dropped_splats(&mut self) {
-        self.dropped.reset();
+        self.state.dropped.reset();
     }
 }

@@ -1,6 +1,5 @@
 //! Sampling and evaluating the learned directional distribution at a point.
 
-use super::validate::unit_direction;
 use super::{SdCell, SdTree};
 use crate::spatial::SpatialTree;
 use glam::Vec3;
@@ -18,19 +17,14 @@ impl SdTree {
     /// [`SdTree::pdf`]`(p, direction)`. `None` for a non-finite `p`.
     #[inline]
     pub fn sample(&self, p: Vec3, u: [f32; 2]) -> Option<(Vec3, f32)> {
-        self.cell_at(p).map(|c| c.directions.sample(u))
+        self.cell_at(p).map(|c| c.sample(u))
     }
 
     /// The solid-angle pdf of `dir` (any positive length) under the guiding
     /// distribution at `p`; 0 for a non-finite `p` or an invalid direction.
     #[inline]
     pub fn pdf(&self, p: Vec3, dir: Vec3) -> f32 {
-        match (self.cell_at(p), unit_direction(dir)) {
-            // The quadtree normalises `dir` itself, exactly as when it
-            // sampled it, so sampled and evaluated pdfs agree bit for bit.
-            (Some(c), Some(_)) => c.directions.pdf(dir),
-            _ => 0.0,
-        }
+        self.cell_at(p).map_or(0.0, |c| c.pdf(dir))
     }
 
     /// The probability `s` of sampling the BSDF rather than the guiding
@@ -40,7 +34,7 @@ impl SdTree {
     pub fn bsdf_fraction(&self, p: Vec3) -> f32 {
         match self.cell_at(p) {
             Some(c) => c.bsdf_fraction(),
-            None => self.config.effective_bsdf_fraction(),
+            None => self.state.config.effective_bsdf_fraction(),
         }
     }
 
@@ -48,14 +42,7 @@ impl SdTree {
     /// `s * bsdf_pdf + (1 - s) * pdf(p, dir)` with `s = bsdf_fraction(p)`.
     #[inline]
     pub fn mixture_pdf(&self, p: Vec3, dir: Vec3, bsdf_pdf: f32) -> f32 {
-        let Some(c) = self.cell_at(p) else {
-            return 0.0;
-        };
-        let guide = match unit_direction(dir) {
-            Some(_) => c.directions.pdf(dir),
-            None => 0.0,
-        };
-        let s = c.bsdf_fraction();
-        s * bsdf_pdf + (1.0 - s) * guide
+        self.cell_at(p)
+            .map_or(0.0, |c| c.mixture_pdf(dir, bsdf_pdf))
     }
 }

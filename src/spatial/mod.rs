@@ -11,6 +11,11 @@
 //! side tables are plain vectors. A split keeps the old number for the lower
 //! child and gives the upper child the next free number.
 //!
+//! Shared by everything that learns per cell: [`BinaryTree::spread`] spreads
+//! a record made at a point over cells by a [`SpatialFilter`], and
+//! [`BinaryTree::split_by_weight`] with [`split_threshold`] is PPG's split
+//! rule (`c * sqrt(2^k)`).
+//!
 //! Lookups clamp points outside the root cube onto it and reject non-finite
 //! points with `None`; nothing in here panics on bad input. Depth is only
 //! limited by `f32` precision (a cell stops splitting once its midpoint
@@ -32,13 +37,18 @@
 
 mod binary_tree;
 mod cell_id;
+mod filter;
 mod overlap;
 mod refine;
 mod root_cube;
+mod split_rule;
 mod tree_trait;
 
 pub use binary_tree::BinaryTree;
 pub use cell_id::{CellId, CellIds};
+pub use filter::SpatialFilter;
+pub(crate) use filter::{jitter_u32x3, jitter_u64};
 pub use refine::RefineOutcome;
 pub use root_cube::{SpatialError, root_cube};
+pub use split_rule::split_threshold;
 pub use tree_trait::SpatialTree;

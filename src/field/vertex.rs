@@ -1,0 +1,173 @@
+//! [`FieldVertex`]: one located cell, serving every query and record at a
+//! path vertex.
+
+use super::{FieldCell, GuidingField};
+use crate::emitter::ShadingContext;
+use crate::glt::{GuidingCut, SplatOutcome};
+use crate::light_sampler::{LightId, LightSample, LightSampler};
+use crate::light_tree::LightHierarchy;
+use crate::math::Aabb;
+use crate::sd_tree::SdCell;
+use crate::spatial::{CellId, SpatialTree, jitter_u64};
+use glam::Vec3;
+use rand_core::Rng;
+
+/// A path vertex located in a [`GuidingField`]: the cell found by the one
+/// lookup ([`GuidingField::vertex`]), through which directional guiding,
+/// light selection and both records at that point go without looking the
+/// cell up again.
+///
+/// Every answer equals the field's by position at the same point. As a
+/// [`LightSampler`] it samples the located cell's cut whatever
+/// `ctx.position` is; `ctx` only feeds the importance below the cut
+/// ([`BelowCut::Importance`](crate::glt::BelowCut::Importance)).
+#[derive(Debug)]
+pub struct FieldVertex<'f, 'a, H: LightHierarchy + ?Sized> {
+    field: &'f GuidingField<'a, H>,
+    cell: &'f FieldCell,
+    p: Vec3,
+    at: (CellId, Aabb),
+}
+
+impl<H: LightHierarchy + ?Sized> Clone for FieldVertex<'_, '_, H> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<H: LightHierarchy + ?Sized> Copy for FieldVertex<'_, '_, H> {}
+
+impl<'f, 'a, H: LightHierarchy + ?Sized> FieldVertex<'f, 'a, H> {
+    #[inline]
+    pub(super) fn new(field: &'f GuidingField<'a, H>, p: Vec3, at: (CellId, Aabb)) -> Self {
+        Self {
+            field,
+            cell: field.cells.data(at.0),
+            p,
+            at,
+        }
+    }
+
+    /// The point this vertex was located from.
+    #[inline]
+    pub fn position(&self) -> Vec3 {
+        self.p
+    }
+
+    /// The cell's number.
+    #[inline]
+    pub fn cell(&self) -> CellId {
+        self.at.0
+    }
+
+    /// The cell's bounds.
+    #[inline]
+    pub fn bounds(&self) -> Aabb {
+        self.at.1
+    }
+
+    /// The cell's SD-tree part.
+    #[inline]
+    pub fn sd(&self) -> &'f SdCell {
+        &self.cell.sd
+    }
+
+    /// The cell's guiding cut.
+    #[inline]
+    pub fn cut(&self) -> &'f GuidingCut {
+        &self.cell.cut
+    }
+
+    /// A direction drawn from the cell's guiding distribution with two
+    /// uniform numbers, and its solid-angle pdf (equal to
+    /// [`FieldVertex::direction_pdf`] of it, bit for bit).
+    #[inline]
+    pub fn sample_direction(&self, u: [f32; 2]) -> (Vec3, f32) {
+        self.cell.sd.sample(u)
+    }
+
+    /// The solid-angle pdf of `dir` (any positive length) under the cell's
+    /// guiding distribution; 0 for an invalid direction.
+    #[inline]
+    pub fn direction_pdf(&self, dir: Vec3) -> f32 {
+        self.cell.sd.pdf(dir)
+    }
+
+    /// The probability `s` of sampling the BSDF rather than the guiding
+    /// distribution here.
+    #[inline]
+    pub fn bsdf_fraction(&self) -> f32 {
+        self.cell.sd.bsdf_fraction()
+    }
+
+    /// The pdf of the one-sample mixture:
+    /// `s * bsdf_pdf + (1 - s) * direction_pdf(dir)`.
+    #[inline]
+    pub fn mixture_pdf(&self, dir: Vec3, bsdf_pdf: f32) -> f32 {
+        self.cell.sd.mixture_pdf(dir, bsdf_pdf)
+    }
+
+    /// Chooses a light from an `f64` number with the unrounded pmf (equal
+    /// bit for bit to [`FieldVertex::light_pmf_exact`]).
+    #[inline]
+    pub fn sample_light_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
+        self.field.guide.sample_exact(&self.cell.cut, ctx, u)
+    }
+
+    /// The unrounded pmf of `light`.
+    #[inline]
+    pub fn light_pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
+        self.field.guide.pmf_exact(&self.cell.cut, ctx, light)
+    }
+
+    /// [`GuidingField::splat_radiance`] at this vertex's position.
+    #[inline]
+    pub fn splat_radiance<R: Rng + ?Sized>(
+        &self,
+        dir: Vec3,
+        radiance: f32,
+        pdf: f32,
+        rng: &mut R,
+    ) -> bool {
+        self.field
+            .splat_radiance_from(self.p, Some(self.at), dir, radiance, pdf, rng)
+    }
+
+    /// [`GuidingField::splat_light`] at this vertex's position.
+    #[inline]
+    pub fn splat_light<R: Rng + ?Sized>(
+        &self,
+        light: LightId,
+        value: f32,
+        rng: &mut R,
+    ) -> SplatOutcome {
+        let filter = (self.field.light_filter, || jitter_u64(rng));
+        self.field
+            .record_light((self.p, Some(self.at)), light, value, filter)
+    }
+
+    /// [`GuidingField::record_fraction`] at this vertex's cell.
+    #[inline]
+    pub fn record_fraction(&self, bsdf_pdf: f32, guiding_pdf: f32, contribution: f32) -> bool {
+        self.field
+            .sd
+            .record_fraction(Some(&self.cell.sd), bsdf_pdf, guiding_pdf, contribution)
+    }
+}
+
+impl<H: LightHierarchy + ?Sized> LightSampler for FieldVertex<'_, '_, H> {
+    /// Applies the GLT's sampling rule with the located cell's cut.
+    #[inline]
+    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+        self.field.guide.sample(&self.cell.cut, ctx, u)
+    }
+
+    #[inline]
+    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        self.field.guide.pmf(&self.cell.cut, ctx, light)
+    }
+
+    fn is_empty(&self) -> bool {
+        self.field.guide.is_empty()
+    }
+}

@@ -1,0 +1,135 @@
+//! Spatial filters: how a record made at a point is spread over cells.
+//!
+//! One implementation for every structure that learns per cell (the
+//! SD-tree's radiance splats, the Guiding Light Tree's light splats, the
+//! combined guiding field's both): [`BinaryTree::spread`] turns a point into
+//! `(cell, weight)` pairs and the caller records into each cell.
+
+use super::{BinaryTree, CellId, SpatialTree};
+use crate::math::Aabb;
+use glam::Vec3;
+use rand_core::Rng;
+
+/// How a splat is spread over spatial cells.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum SpatialFilter {
+    /// All of it goes to the cell containing the position.
+    #[default]
+    Nearest,
+    /// The position is jittered uniformly within a box the size of the cell
+    /// containing it (`+-1/2` cell per axis, random bits from the caller's
+    /// `rand_core::Rng`), then the cell containing the jittered position
+    /// (clamped to the root) takes all of it. Same cost as `Nearest`, the
+    /// box filter in expectation.
+    StochasticBox,
+    /// The cell-sized box centred on the position is intersected with every
+    /// cell it overlaps; each gets the fraction of the box's volume it
+    /// covers, of both the value and the statistical weight. The box is
+    /// clipped to the root first, so the fractions always sum to 1 (PPG
+    /// loses the part outside the scene).
+    Box,
+}
+
+impl<T> BinaryTree<T> {
+    /// Spreads a record made at `p` over the cells by `filter`: calls
+    /// `visit(cell, weight)` for every cell that gets a part, with weights
+    /// in `(0, 1]` that sum to 1 (to rounding, for [`SpatialFilter::Box`]).
+    /// Returns false, visiting nothing, when `p` is not finite.
+    ///
+    /// The filter box is centred on `p` clamped onto the root cube and has
+    /// the size of the cell holding `p`. `jitter` is called once, by
+    /// [`SpatialFilter::StochasticBox`] only, and gives the offset from the
+    /// centre in cell widths, each coordinate in `[-1/2, 1/2)`.
+    #[inline]
+    pub fn spread(
+        &self,
+        p: Vec3,
+        filter: SpatialFilter,
+        jitter: impl FnOnce() -> Vec3,
+        visit: impl FnMut(CellId, f32),
+    ) -> bool {
+        match self.locate_with_bounds(p) {
+            Some(at) => {
+                self.spread_from(p, at, filter, jitter, visit);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// [`BinaryTree::spread`] for a point already located: `at` is what
+    /// [`BinaryTree::locate_with_bounds`] returned for `p` (so one lookup
+    /// per path vertex can serve its queries and its splats).
+    #[inline]
+    pub fn spread_from(
+        &self,
+        p: Vec3,
+        at: (CellId, Aabb),
+        filter: SpatialFilter,
+        jitter: impl FnOnce() -> Vec3,
+        mut visit: impl FnMut(CellId, f32),
+    ) {
+        let (cell, bounds) = at;
+        match filter {
+            SpatialFilter::Nearest => visit(cell, 1.0),
+            SpatialFilter::StochasticBox => {
+                let q = self.root.clamp(p) + jitter() * bounds.diagonal();
+                // `q` is finite: a finite point plus at most a cell's size.
+                visit(self.locate(q).unwrap_or(cell), 1.0);
+            }
+            SpatialFilter::Box => self.spread_box(p, &bounds, visit),
+        }
+    }
+
+    /// Spreads over the cells overlapping the cell-sized box around `p`,
+    /// by overlap volume (the box is clipped to the root first).
+    fn spread_box(&self, p: Vec3, cell_bounds: &Aabb, mut visit: impl FnMut(CellId, f32)) {
+        let centre = self.root.clamp(p);
+        let half = cell_bounds.diagonal() * 0.5;
+        let region = Aabb {
+            min: centre - half,
+            max: centre + half,
+        }
+        .intersection(&self.root);
+        let volume = volume64(&region);
+        if volume.is_nan() || volume <= 0.0 {
+            // Unreachable for a real cell; keep the record anyway.
+            if let Some(c) = self.locate(centre) {
+                visit(c, 1.0);
+            }
+            return;
+        }
+        self.for_each_overlapping(&region, |cell, bounds| {
+            let w = volume64(&bounds.intersection(&region)) / volume;
+            if w > 0.0 {
+                visit(cell, w as f32);
+            }
+        });
+    }
+}
+
+/// A stochastic-box offset from three `next_u32` of `rng` (24 bits per
+/// axis), each coordinate in `[-1/2, 1/2)`: the SD-tree's draw.
+#[inline]
+pub(crate) fn jitter_u32x3<R: Rng + ?Sized>(rng: &mut R) -> Vec3 {
+    let mut unit = || (rng.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32);
+    Vec3::new(unit(), unit(), unit()) - 0.5
+}
+
+/// A stochastic-box offset from one `next_u64` of `rng` (21 bits per axis),
+/// each coordinate in `[-1/2, 1/2)`: the Guiding Light Tree's draw.
+#[inline]
+pub(crate) fn jitter_u64<R: Rng + ?Sized>(rng: &mut R) -> Vec3 {
+    let bits = rng.next_u64();
+    let unit = |k: u32| ((bits >> (k * 21)) & 0x1f_ffff) as f32 * (1.0 / 2_097_152.0) - 0.5;
+    Vec3::new(unit(0), unit(1), unit(2))
+}
+
+#[inline]
+fn volume64(b: &Aabb) -> f64 {
+    if b.is_empty() {
+        return 0.0;
+    }
+    let d = b.diagonal();
+    d.x as f64 * d.y as f64 * d.z as f64
+}
