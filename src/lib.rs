@@ -35,12 +35,39 @@
 //! ## Layers
 //!
 //! Each module only uses the ones above it:
-//! 1. [`math`]: boxes, cones, the sphere map, the exact one-number descent,
-//!    thread-safe sums;
+//! 1. [`math`]: boxes, cones, the sphere map, the exact one-number
+//!    [`math::Descent`], thread-safe [`math::SumBuffer`]s;
 //! 2. [`emitter`]: the [`Emitters`] trait and [`ShadingContext`];
 //! 3. [`light_tree`]: [`LightHierarchy`] and the [`LightTree`] BVH;
-//! 4. [`light_sampler`]: [`LightSampler`] and its baselines.
+//! 4. [`light_sampler`]: [`LightSampler`] and its baselines;
+//! 5. [`spatial`]: the spatial tree trait and PPG's binary tree;
+//! 6. [`quadtree`] and [`sd_tree`]: PPG's directional quadtree and SD-tree;
+//! 7. [`glt`]: the Guiding Light Tree, itself a [`LightSampler`];
+//! 8. [`field`]: one spatial tree holding a quadtree and a cut per cell, as
+//!    the paper uses them; [`schedule`]: PPG's iteration schedule and the
+//!    inverse-variance combination of the last iterations.
 //!
+//! ## Where things are
+//!
+//! | what | file |
+//! | --- | --- |
+//! | the GLT's sampling rule and pmf | `src/glt/sampling.rs` |
+//! | cut refinement (split / merge by sigma) | `src/glt/refine.rs` |
+//! | light-tree build heuristics | `src/light_tree/build.rs` |
+//! | the importance of a light cluster | `src/light_sampler/importance.rs` |
+//! | the one-number descent | `src/math/descent.rs` |
+//! | quadtree sampling and pdf | `src/quadtree/query.rs` |
+//!
+//! ## Contracts
+//!
+//! - `sample` returns exactly the probability `pmf` (or `pdf`) reports for the
+//!   same input, and pmfs sum to 1 (or are all 0 when nothing can be sampled).
+//! - Queries and records take `&self` and may run from many threads; `refine`
+//!   takes `&mut self` between iterations. [`math::Accumulation::Deterministic`]
+//!   makes learned state bit-identical whatever the thread count.
+//! - Bad input never panics: builds return typed errors, records drop and
+//!   count it.
+
 //! ## Features
 //!
 //! - `std` (default): use the standard library. Without it the crate is
