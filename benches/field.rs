@@ -22,32 +22,15 @@ use guiding::sd_tree::{SdTree, SdTreeConfig};
 use guiding::spatial::SpatialTree;
 use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
 use rand_pcg::Pcg64Mcg;
-use rand_pcg::rand_core::{Rng, SeedableRng};
+use rand_pcg::rand_core::SeedableRng;
 use std::hint::black_box;
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+use common::Rand;
 
 const LIGHTS: usize = 10_000;
 const QUERIES: usize = 4096;
-
-struct Rand(Pcg64Mcg);
-
-impl Rand {
-    fn new(seed: u64) -> Self {
-        Self(Pcg64Mcg::seed_from_u64(seed))
-    }
-    fn f(&mut self) -> f32 {
-        (self.0.next_u32() >> 8) as f32 / (1u32 << 24) as f32
-    }
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.f()
-    }
-    fn point(&mut self) -> Vec3 {
-        Vec3::new(
-            self.range(-100.0, 100.0),
-            self.range(-100.0, 100.0),
-            self.range(-100.0, 100.0),
-        )
-    }
-}
 
 fn scene() -> Aabb {
     Aabb::new(Vec3::splat(-100.0), Vec3::splat(100.0))
@@ -57,7 +40,7 @@ fn lights() -> Vec<Emitter> {
     let mut rng = Rand::new(1);
     (0..LIGHTS)
         .map(|i| {
-            let (p, power) = (rng.point(), rng.range(0.1, 10.0));
+            let (p, power) = (rng.point(100.0), rng.range(0.1, 10.0));
             if i % 2 == 0 {
                 Emitter::point(p, power)
             } else {
@@ -87,7 +70,7 @@ struct Record {
 }
 
 fn record(lights: &[Emitter], rng: &mut Rand) -> Record {
-    let p = rng.point();
+    let p = rng.point(100.0);
     let u = rng.f();
     let e = ((rng.f() * LIGHTS as f32) as u32 & !3).min(LIGHTS as u32 - 4);
     let to = lights[e as usize].bounds.center() - p;
@@ -178,7 +161,7 @@ fn bench_field(c: &mut Criterion) {
     let mut rng = Rand::new(3);
     let queries: Vec<(ShadingContext, [f32; 3])> = (0..QUERIES)
         .map(|_| {
-            let ctx = ShadingContext::on_surface(rng.point(), Vec3::Y);
+            let ctx = ShadingContext::on_surface(rng.point(100.0), Vec3::Y);
             (ctx, [rng.f(), rng.f(), rng.f()])
         })
         .collect();

@@ -22,26 +22,14 @@ use guiding::light_sampler::EnergyTreeSampler;
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Aabb;
 use guiding::{Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext};
-use rand_pcg::Pcg64Mcg;
-use rand_pcg::rand_core::{Rng, SeedableRng};
 use std::hint::black_box;
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+use common::Rand;
 
 const LIGHTS: [usize; 5] = [100, 1_000, 10_000, 100_000, 1_000_000];
 const SIGMAS: [f64; 3] = [0.05, 0.01, 0.002];
-
-struct Rand(Pcg64Mcg);
-
-impl Rand {
-    fn new(seed: u64) -> Self {
-        Self(Pcg64Mcg::seed_from_u64(seed))
-    }
-    fn f(&mut self) -> f32 {
-        (self.0.next_u32() >> 8) as f32 / (1u32 << 24) as f32
-    }
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.f()
-    }
-}
 
 fn scene(n: usize) -> (Vec<Emitter>, LightTree) {
     let mut rng = Rand::new(n as u64);

@@ -6,14 +6,14 @@
 //! `-- build/Sarh` to run less.
 
 use criterion::{BenchmarkId, Criterion, SamplingMode, criterion_group, criterion_main};
-use glam::Vec3;
 use guiding::light_tree::BuildHeuristic;
-use guiding::math::{Aabb, LightCone};
-use guiding::{Emitter, LightHierarchy, LightTree};
-use rand_pcg::Pcg64Mcg;
-use rand_pcg::rand_core::{Rng, SeedableRng};
+use guiding::{LightHierarchy, LightTree};
 use std::hint::black_box;
 use std::time::Duration;
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+use common::mixed_scene;
 
 const HEURISTICS: [BuildHeuristic; 4] = [
     BuildHeuristic::Balanced,
@@ -22,70 +22,6 @@ const HEURISTICS: [BuildHeuristic; 4] = [
     BuildHeuristic::Saoh,
 ];
 const SIZES: [usize; 4] = [1_000, 10_000, 100_000, 1_000_000];
-
-struct Rand(Pcg64Mcg);
-
-impl Rand {
-    fn f(&mut self) -> f32 {
-        (self.0.next_u32() >> 8) as f32 / (1u32 << 24) as f32
-    }
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.f()
-    }
-    fn dir(&mut self) -> Vec3 {
-        loop {
-            let v = Vec3::new(
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-            );
-            if let Some(d) = v.try_normalize() {
-                return d;
-            }
-        }
-    }
-}
-
-fn quad(c: Vec3, n: Vec3, s: f32, power: f32) -> Emitter {
-    let (t, b) = n.any_orthonormal_pair();
-    let mut bounds = Aabb::EMPTY;
-    for (u, v) in [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)] {
-        bounds = bounds.extend(c + (t * u + b * v) * s);
-    }
-    Emitter::area(bounds, n, 4.0 * s * s, power)
-}
-
-/// The scene of the tests and the stats example: 40% quads (half facing
-/// down), 30% spheres, 20% point and 10% spot lights in a 100^3 box, powers
-/// log-uniform over five decades.
-fn mixed_scene(n: usize, seed: u64) -> Vec<Emitter> {
-    let mut r = Rand(Pcg64Mcg::seed_from_u64(seed));
-    (0..n)
-        .map(|_| {
-            let c = Vec3::new(
-                r.range(-50.0, 50.0),
-                r.range(-50.0, 50.0),
-                r.range(-50.0, 50.0),
-            );
-            let power = 10f32.powf(r.range(-2.0, 3.0));
-            let kind = r.f();
-            if kind < 0.4 {
-                let normal = if r.f() < 0.5 { -Vec3::Y } else { r.dir() };
-                let mut e = quad(c, normal, r.range(0.05, 2.0), power);
-                e.two_sided = r.f() < 0.1;
-                e
-            } else if kind < 0.7 {
-                Emitter::sphere(c, r.range(0.05, 1.0), power)
-            } else if kind < 0.9 {
-                Emitter::point(c, power)
-            } else {
-                let mut e = Emitter::point(c, power);
-                e.cone = Some(LightCone::spot(r.dir(), r.range(0.1, 1.2)));
-                e
-            }
-        })
-        .collect()
-}
 
 /// Prints the tree's shape and memory once per heuristic and size.
 fn report_memory() {

@@ -16,43 +16,15 @@ use proptest::prelude::*;
 use rand_pcg::Pcg32;
 use rand_pcg::rand_core::{Rng, SeedableRng};
 
-struct Rand(Pcg32);
+mod common;
+use common::{scene, two_rooms_with, value};
 
-impl Rand {
-    fn new(seed: u64) -> Self {
-        Self(Pcg32::seed_from_u64(seed))
-    }
-    fn f(&mut self) -> f32 {
-        (self.0.next_u32() >> 8) as f32 / (1u32 << 24) as f32
-    }
-    fn f64(&mut self) -> f64 {
-        (self.0.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.f()
-    }
-    fn point(&mut self, r: f32) -> Vec3 {
-        Vec3::new(self.range(-r, r), self.range(-r, r), self.range(-r, r))
-    }
-}
+/// The shared generator over `Pcg32`: these tests were tuned on its streams.
+type Rand = common::Rand<Pcg32>;
 
-/// 40 lights at x = -8 and 40 at x = +8; a wall at x = 0 means each half of
-/// the scene sees only its own side's lights.
+/// The two rooms drawn from `Pcg32`.
 fn two_rooms() -> Vec<Emitter> {
-    let mut rng = Rand::new(17);
-    (0..80)
-        .map(|i| {
-            let x = if i < 40 { -8.0 } else { 8.0 };
-            Emitter::point(
-                Vec3::new(x, rng.range(-4.0, 4.0), rng.range(-4.0, 4.0)),
-                rng.range(1.0, 3.0),
-            )
-        })
-        .collect()
-}
-
-fn scene() -> Aabb {
-    Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0))
+    two_rooms_with::<Pcg32>()
 }
 
 /// The two rooms and their light tree.
@@ -76,15 +48,6 @@ fn config_with(c: f32, sd: SdTreeConfig) -> FieldConfig {
         sd: sd_with(c, sd),
         ..FieldConfig::default()
     }
-}
-
-/// Contribution of light `e` at `p` in the two rooms.
-fn value(lights: &[Emitter], e: u32, p: Vec3) -> f32 {
-    let c = lights[e as usize].bounds.center();
-    if (c.x < 0.0) != (p.x < 0.0) {
-        return 0.0;
-    }
-    lights[e as usize].power / (c - p).length_squared().max(1.0)
 }
 
 /// A direction toward one of the lights of `p`'s room, slightly perturbed.
@@ -148,7 +111,7 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
     let mut sd = SdTree::new(scene(), sd_config).unwrap();
     let guide = GuidingTree::new(&tree, config.cut);
     let mut cuts = vec![guide.new_cut()];
-    let mut rng = Rand::new(1);
+    let mut rng = Rand::seeded(1);
     let mut learned = false;
     for it in 0..5 {
         for _ in 0..(3000usize << it.min(2)) {
@@ -273,7 +236,7 @@ fn equals_a_glt_fed_the_same_light_splats() {
     };
     assert_eq!(config.light_filter, SpatialFilter::StochasticBox);
     let mut field = GuidingField::new(&tree, scene(), config).unwrap();
-    let mut rng = Rand::new(4);
+    let mut rng = Rand::seeded(4);
     let compare =
         |field: &GuidingField<'_, LightTree>, glt: &Glt<'_, LightTree>, rng: &mut Rand| {
             assert_eq!(field.cell_count(), glt.spatial().cell_count());
@@ -371,7 +334,7 @@ proptest! {
         importance in any::<bool>(),
         iterations in 0usize..4,
     ) {
-        let mut rng = Rand::new(seed);
+        let mut rng = Rand::seeded(seed);
         let dark = dark.min(n - 1);
         let lights = random_lights(&mut rng, n, dark);
         let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
@@ -436,7 +399,7 @@ fn trained_field<'a>(
     mut after_refine: impl FnMut(&GuidingField<'a, LightTree>, RefineOutcome),
 ) -> GuidingField<'a, LightTree> {
     let mut field = GuidingField::new(tree, scene(), config).unwrap();
-    let mut rng = Rand::new(8);
+    let mut rng = Rand::seeded(8);
     for it in 0..4 {
         for _ in 0..(3000usize << it.min(2)) {
             let p = rng.point(9.8);
@@ -506,7 +469,7 @@ fn spatial_split_copies_both_payloads() {
     let mut field = GuidingField::new(&tree, scene(), config).unwrap();
     let p = Vec3::new(-9.0, -9.0, -9.0);
     let dir = Vec3::new(0.2, 1.0, 0.1);
-    let mut rng = Rand::new(6);
+    let mut rng = Rand::seeded(6);
     let round = |field: &GuidingField<'_, LightTree>, rng: &mut Rand| {
         let v = field.vertex(p).unwrap();
         for _ in 0..1000 {
@@ -579,7 +542,7 @@ fn bad_input_is_dropped_and_counted() {
         ..FieldConfig::default()
     };
     let mut field = GuidingField::new(&tree, scene(), config).unwrap();
-    let mut rng = Rand::new(5);
+    let mut rng = Rand::seeded(5);
     let p = Vec3::ONE;
     let nan = Vec3::new(f32::NAN, 0.0, 0.0);
     let v = field.vertex(p).unwrap();
@@ -678,7 +641,7 @@ struct Input {
 }
 
 fn inputs(lights: &[Emitter], n: usize, seed: u64) -> Vec<Input> {
-    let mut rng = Rand::new(seed);
+    let mut rng = Rand::seeded(seed);
     (0..n)
         .map(|i| {
             let p = rng.point(9.8);
@@ -788,7 +751,7 @@ fn memory_report_adds_up_and_compares_cuts_with_quadtrees() {
     // An SD-tree fed the same radiance splats: same random stream, and the
     // light splats (nearest) draw nothing from it.
     let mut sd = SdTree::new(scene(), sd_config).unwrap();
-    let mut rng = Rand::new(8);
+    let mut rng = Rand::seeded(8);
     for it in 0..4 {
         for _ in 0..(3000usize << it.min(2)) {
             let p = rng.point(9.8);

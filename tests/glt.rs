@@ -12,37 +12,13 @@ use guiding::light_tree::{BuildHeuristic, EmitterPath, NodeBounds};
 use guiding::math::{Aabb, Accumulation, LightCone, Side};
 use guiding::{Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext};
 use proptest::prelude::*;
-use rand_pcg::Pcg64Mcg;
-use rand_pcg::rand_core::{Rng, SeedableRng};
+
+mod common;
+use common::Rand;
 
 // ---------------------------------------------------------------------------
 // Helpers
 // ---------------------------------------------------------------------------
-
-struct Rand(Pcg64Mcg);
-
-impl Rand {
-    fn new(seed: u64) -> Self {
-        Self(Pcg64Mcg::seed_from_u64(seed))
-    }
-    /// Uniform f32 in [0, 1) on the 2^-24 grid.
-    fn f(&mut self) -> f32 {
-        (self.0.next_u32() >> 8) as f32 / (1u32 << 24) as f32
-    }
-    /// Uniform f64 in [0, 1) on the 2^-53 grid.
-    fn f64(&mut self) -> f64 {
-        (self.0.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.f()
-    }
-    fn below(&mut self, n: u32) -> u32 {
-        (((self.0.next_u64() >> 32) * n as u64) >> 32) as u32
-    }
-    fn point(&mut self, r: f32) -> Vec3 {
-        Vec3::new(self.range(-r, r), self.range(-r, r), self.range(-r, r))
-    }
-}
 
 /// Every leaf of `tree` lies below exactly one cluster of the cut (checked
 /// by counting leaves, independently of `GuidingCut::check`), the structural

@@ -23,19 +23,9 @@ use guiding::glt::{BelowCut, CutConfig, Glt, GltConfig, SplitPrior};
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Aabb;
 use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
-use rand_pcg::Pcg64Mcg;
-use rand_pcg::rand_core::{Rng, SeedableRng};
 
-struct Rand(Pcg64Mcg);
-
-impl Rand {
-    fn new(seed: u64) -> Self {
-        Self(Pcg64Mcg::seed_from_u64(seed))
-    }
-    fn f(&mut self) -> f32 {
-        (self.0.next_u32() >> 8) as f32 / (1u32 << 24) as f32
-    }
-}
+mod common;
+use common::Rand;
 
 fn env(name: &str, default: u64) -> u64 {
     std::env::var(name)

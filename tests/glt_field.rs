@@ -6,59 +6,12 @@
 use glam::Vec3;
 use guiding::glt::{CutConfig, Glt, GltConfig, GltMemory, SplatOutcome};
 use guiding::light_tree::BuildHeuristic;
-use guiding::math::{Aabb, Accumulation};
+use guiding::math::Accumulation;
 use guiding::spatial::SpatialTree;
 use guiding::{Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext};
-use rand_pcg::Pcg64Mcg;
-use rand_pcg::rand_core::{Rng, SeedableRng};
 
-struct Rand(Pcg64Mcg);
-
-impl Rand {
-    fn new(seed: u64) -> Self {
-        Self(Pcg64Mcg::seed_from_u64(seed))
-    }
-    fn f(&mut self) -> f32 {
-        (self.0.next_u32() >> 8) as f32 / (1u32 << 24) as f32
-    }
-    fn f64(&mut self) -> f64 {
-        (self.0.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.f()
-    }
-    fn point(&mut self, r: f32) -> Vec3 {
-        Vec3::new(self.range(-r, r), self.range(-r, r), self.range(-r, r))
-    }
-}
-
-/// 40 lights at x = -8 and 40 at x = +8; a wall at x = 0 means each half of
-/// the scene sees only its own side's lights.
-fn two_rooms() -> Vec<Emitter> {
-    let mut rng = Rand::new(17);
-    (0..80)
-        .map(|i| {
-            let x = if i < 40 { -8.0 } else { 8.0 };
-            Emitter::point(
-                Vec3::new(x, rng.range(-4.0, 4.0), rng.range(-4.0, 4.0)),
-                rng.range(1.0, 3.0),
-            )
-        })
-        .collect()
-}
-
-fn scene() -> Aabb {
-    Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0))
-}
-
-/// Contribution of light `e` at `p` in the two rooms.
-fn value(lights: &[Emitter], e: u32, p: Vec3) -> f32 {
-    let c = lights[e as usize].bounds.center();
-    if (c.x < 0.0) != (p.x < 0.0) {
-        return 0.0;
-    }
-    lights[e as usize].power / (c - p).length_squared().max(1.0)
-}
+mod common;
+use common::{Rand, scene, two_rooms, value};
 
 /// Trains `glt` for `iterations` iterations of `per_iteration` jittered
 /// splats, sampling lights from the GLT itself as a renderer would.

@@ -9,8 +9,9 @@ use glam::Vec3;
 use guiding::light_tree::{BuildError, BuildHeuristic, LightNode};
 use guiding::math::{Aabb, LightCone, Side};
 use guiding::{Emitter, Emitters, LightHierarchy, LightTree};
-use rand_pcg::Pcg64Mcg;
-use rand_pcg::rand_core::{Rng, SeedableRng};
+
+mod common;
+use common::{Rand, mixed_scene, quad};
 
 const HEURISTICS: [BuildHeuristic; 4] = [
     BuildHeuristic::Balanced,
@@ -22,77 +23,6 @@ const HEURISTICS: [BuildHeuristic; 4] = [
 // ---------------------------------------------------------------------------
 // Scene generators
 // ---------------------------------------------------------------------------
-
-struct Rand(Pcg64Mcg);
-
-impl Rand {
-    fn new(seed: u64) -> Self {
-        Self(Pcg64Mcg::seed_from_u64(seed))
-    }
-    /// Uniform in [0, 1).
-    fn f(&mut self) -> f32 {
-        (self.0.next_u32() >> 8) as f32 / (1u32 << 24) as f32
-    }
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.f()
-    }
-    fn bits(&mut self) -> u32 {
-        self.0.next_u32()
-    }
-    fn dir(&mut self) -> Vec3 {
-        loop {
-            let v = Vec3::new(
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-            );
-            if let Some(d) = v.try_normalize() {
-                return d;
-            }
-        }
-    }
-}
-
-/// A quad of half-size `s` centred at `c` facing `n`.
-fn quad(c: Vec3, n: Vec3, s: f32, power: f32) -> Emitter {
-    let (t, b) = n.any_orthonormal_pair();
-    let mut bounds = Aabb::EMPTY;
-    for (u, v) in [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)] {
-        bounds = bounds.extend(c + (t * u + b * v) * s);
-    }
-    Emitter::area(bounds, n, 4.0 * s * s, power)
-}
-
-/// A mix of quads (half facing down, some two-sided), spheres, point and spot
-/// lights with powers spanning five decades.
-fn mixed_scene(n: usize, seed: u64) -> Vec<Emitter> {
-    let mut r = Rand::new(seed);
-    (0..n)
-        .map(|_| {
-            let c = Vec3::new(
-                r.range(-50.0, 50.0),
-                r.range(-50.0, 50.0),
-                r.range(-50.0, 50.0),
-            );
-            let power = 10f32.powf(r.range(-2.0, 3.0));
-            let kind = r.f();
-            if kind < 0.4 {
-                let normal = if r.f() < 0.5 { -Vec3::Y } else { r.dir() };
-                let mut e = quad(c, normal, r.range(0.05, 2.0), power);
-                e.two_sided = r.f() < 0.1;
-                e
-            } else if kind < 0.7 {
-                Emitter::sphere(c, r.range(0.05, 1.0), power)
-            } else if kind < 0.9 {
-                Emitter::point(c, power)
-            } else {
-                let mut e = Emitter::point(c, power);
-                e.cone = Some(LightCone::spot(r.dir(), r.range(0.1, 1.2)));
-                e
-            }
-        })
-        .collect()
-}
 
 /// A chain that SARH (and SAH, SAOH) split one emitter at a time: emitter k
 /// sits at 2^(50-k) on the x axis with size and power shrinking by 2 and 4

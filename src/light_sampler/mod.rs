@@ -20,6 +20,7 @@ mod importance;
 mod power;
 mod tree_energy;
 mod tree_importance;
+mod tree_walk;
 mod uniform;
 
 pub use environment::WithEnvironment;

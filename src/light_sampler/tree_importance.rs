@@ -3,10 +3,9 @@
 //! `BVHLightSampler`).
 
 use super::importance::Query;
-use super::{LightId, LightSample, LightSampler, pmf_to_f32};
+use super::{LightId, LightSample, LightSampler, tree_walk};
 use crate::emitter::ShadingContext;
 use crate::light_tree::LightHierarchy;
-use crate::light_tree::descend::{descend, follow};
 use crate::math::Descent;
 
 /// Descends a [`LightHierarchy`] choosing, at each inner node, between the
@@ -49,13 +48,6 @@ impl<'a, H: LightHierarchy + ?Sized> ImportanceTreeSampler<'a, H> {
         self.tree
     }
 
-    /// The root, when it has positive energy.
-    #[inline]
-    fn live_root(&self) -> Option<u32> {
-        let root = self.tree.root()?;
-        (self.tree.energy(root) > 0.0).then_some(root)
-    }
-
     /// The descent weights of children `l` and `r` at `ctx`: their
     /// importances, or their energies when those are both zero (or
     /// unusable).
@@ -77,37 +69,16 @@ impl<'a, H: LightHierarchy + ?Sized> ImportanceTreeSampler<'a, H> {
 impl<H: LightHierarchy + ?Sized> LightSampler for ImportanceTreeSampler<'_, H> {
     #[inline]
     fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
-        let root = self.live_root()?;
-        let mut d = Descent::new(u);
-        let leaf = descend(self.tree, root, &mut d, self.weights(ctx))?;
-        let emitter = self.tree.emitter(leaf)?;
-        let pmf = pmf_to_f32(d.pmf());
-        (pmf > 0.0).then_some(LightSample {
-            light: LightId::Emitter(emitter),
-            pmf,
-        })
+        tree_walk::sample(self.tree, u, self.weights(ctx))
     }
 
     #[inline]
     fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        let LightId::Emitter(emitter) = light else {
-            return 0.0;
-        };
-        if self.live_root().is_none() {
-            return 0.0;
-        }
-        let Some(path) = self.tree.path(emitter) else {
-            return 0.0;
-        };
-        let mut d = Descent::evaluate();
-        if !follow(self.tree, path.steps(), &mut d, self.weights(ctx)) {
-            return 0.0;
-        }
-        pmf_to_f32(d.pmf())
+        tree_walk::pmf(self.tree, light, self.weights(ctx))
     }
 
     #[inline]
     fn is_empty(&self) -> bool {
-        self.live_root().is_none()
+        tree_walk::live_root(self.tree).is_none()
     }
 }

@@ -16,5 +16,6 @@ pub(crate) use cone::angle_between as cone_angle_between;
 pub use counter::Counter;
 pub(crate) use descent::pmf_to_f32;
 pub use descent::{Descent, Side};
+pub(crate) use sphere_map::unit_direction;
 pub use sphere_map::{SPHERE_MAP_JACOBIAN, canonical_to_dir, dir_to_canonical};
 pub use sum::{Accumulation, SumBuffer};

@@ -34,6 +34,22 @@ pub fn dir_to_canonical(d: Vec3) -> Vec2 {
 
 const ONE_MINUS_EPS: f32 = 1.0 - f32::EPSILON / 2.0;
 
+/// `dir` scaled to unit length; `None` when it has a NaN or infinite
+/// component or is zero. Tiny and huge directions are rescaled before
+/// normalising, so any finite non-zero vector works.
+#[inline]
+pub(crate) fn unit_direction(dir: Vec3) -> Option<Vec3> {
+    if !dir.is_finite() {
+        return None;
+    }
+    let m = dir.abs().max_element();
+    if m == 0.0 {
+        return None;
+    }
+    let d = dir / m;
+    Some(d / d.length())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

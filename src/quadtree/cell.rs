@@ -2,23 +2,15 @@
 //! trees descend with: `x = floor(u * 2^32)`, so the quadrant at every level
 //! is one bit and a cell's membership test is a shift, exact at any depth.
 
-use crate::math::dir_to_canonical;
+use crate::math::{dir_to_canonical, unit_direction};
 use glam::{Vec2, Vec3};
 
 /// The canonical point of a direction of any positive length; `None` for a
-/// zero, NaN or infinite vector. The vector is scaled then normalised, so
-/// tiny vectors do not underflow.
+/// zero, NaN or infinite vector. The vector is scaled then normalised (see
+/// [`unit_direction`]), so tiny vectors do not underflow.
 #[inline]
 pub(crate) fn canonical_of(dir: Vec3) -> Option<Vec2> {
-    if !dir.is_finite() {
-        return None;
-    }
-    let m = dir.abs().max_element();
-    if m == 0.0 {
-        return None;
-    }
-    let d = dir / m;
-    Some(dir_to_canonical(d / d.length()))
+    unit_direction(dir).map(dir_to_canonical)
 }
 
 /// A canonical point in 32-bit fixed point per axis.

@@ -5,7 +5,7 @@
 
 use super::config::SdTreeConfig;
 use super::fraction::{FRACTION_SUMS, FractionLearner};
-use super::validate::unit_direction;
+use crate::math::unit_direction;
 use crate::math::{Accumulation, SumBuffer};
 use crate::quadtree::{DirectionalFilter, DirectionalTree};
 use glam::Vec3;

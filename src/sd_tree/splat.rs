@@ -2,9 +2,10 @@
 
 use super::dropped::DropReason;
 use super::state::SdState;
-use super::validate::{splat_value, unit_direction};
+use super::validate::splat_value;
 use super::{SdCell, SdTree, SpatialFilter};
 use crate::math::Aabb;
+use crate::math::unit_direction;
 use crate::quadtree::DirectionalFilter;
 use crate::spatial::{BinaryTree, CellId, SpatialTree, jitter_u32x3};
 use glam::Vec3;

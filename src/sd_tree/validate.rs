@@ -1,23 +1,6 @@
 //! Checking the inputs of queries and splats.
 
 use super::dropped::DropReason;
-use glam::Vec3;
-
-/// `dir` scaled to unit length; `None` when it has a NaN or infinite
-/// component or is zero. Tiny and huge directions are rescaled before
-/// normalising, so any finite non-zero vector works.
-#[inline]
-pub(super) fn unit_direction(dir: Vec3) -> Option<Vec3> {
-    if !dir.is_finite() {
-        return None;
-    }
-    let m = dir.abs().max_element();
-    if m == 0.0 {
-        return None;
-    }
-    let d = dir / m;
-    Some(d / d.length())
-}
 
 /// The value a splat records, `radiance / pdf`, or why it is dropped.
 #[inline]

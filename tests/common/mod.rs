@@ -1,0 +1,244 @@
+//! Helpers shared by the tests, the benchmarks and the example: a seeded
+//! random-number wrapper, the mixed emitter scene, the two-room scene and
+//! the incomplete gamma function behind the chi-square tests.
+//!
+//! Tests include it with `mod common;`, benchmarks and examples with
+//! `#[path = "../tests/common/mod.rs"] mod common;`. Not every crate uses
+//! every helper.
+#![allow(dead_code)]
+
+use glam::Vec3;
+use guiding::Emitter;
+use guiding::math::{Aabb, LightCone};
+use rand_pcg::Pcg64Mcg;
+use rand_pcg::rand_core::{Rng, SeedableRng};
+
+// ---------------------------------------------------------------------------
+// Random numbers
+// ---------------------------------------------------------------------------
+
+/// A seeded generator with the draws the tests need; `R` is the PCG
+/// variant (the field tests use `Pcg32`, everything else `Pcg64Mcg`).
+pub struct Rand<R = Pcg64Mcg>(pub R);
+
+impl Rand {
+    /// A `Pcg64Mcg` seeded with `seed`.
+    pub fn new(seed: u64) -> Self {
+        Self::seeded(seed)
+    }
+}
+
+impl<R: SeedableRng> Rand<R> {
+    /// An `R` seeded with `seed`.
+    pub fn seeded(seed: u64) -> Self {
+        Self(R::seed_from_u64(seed))
+    }
+}
+
+impl<R: Rng> Rand<R> {
+    /// Uniform f32 in [0, 1) on the 2^-24 grid.
+    pub fn f(&mut self) -> f32 {
+        (self.0.next_u32() >> 8) as f32 / (1u32 << 24) as f32
+    }
+    /// Uniform f64 in [0, 1) on the 2^-53 grid.
+    pub fn f64(&mut self) -> f64 {
+        (self.0.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    /// Uniform in [lo, hi).
+    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.f()
+    }
+    /// 32 random bits.
+    pub fn bits(&mut self) -> u32 {
+        self.0.next_u32()
+    }
+    /// Uniform integer in [0, n).
+    pub fn below(&mut self, n: u32) -> u32 {
+        (((self.0.next_u64() >> 32) * n as u64) >> 32) as u32
+    }
+    /// Uniform in the cube [-r, r)^3.
+    pub fn point(&mut self, r: f32) -> Vec3 {
+        Vec3::new(self.range(-r, r), self.range(-r, r), self.range(-r, r))
+    }
+    /// A uniform unit direction (rejection from the cube).
+    pub fn dir(&mut self) -> Vec3 {
+        loop {
+            let v = Vec3::new(
+                self.range(-1.0, 1.0),
+                self.range(-1.0, 1.0),
+                self.range(-1.0, 1.0),
+            );
+            if let Some(d) = v.try_normalize() {
+                return d;
+            }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// The mixed scene
+// ---------------------------------------------------------------------------
+
+/// A quad of half-size `s` centred at `c` facing `n`.
+pub fn quad(c: Vec3, n: Vec3, s: f32, power: f32) -> Emitter {
+    let (t, b) = n.any_orthonormal_pair();
+    let mut bounds = Aabb::EMPTY;
+    for (u, v) in [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)] {
+        bounds = bounds.extend(c + (t * u + b * v) * s);
+    }
+    Emitter::area(bounds, n, 4.0 * s * s, power)
+}
+
+/// `n` emitters of [`mixed_scene_from`] drawn from a `Pcg64Mcg` seeded with
+/// `seed`.
+pub fn mixed_scene(n: usize, seed: u64) -> Vec<Emitter> {
+    mixed_scene_from(n, &mut Rand::new(seed))
+}
+
+/// 40% quads (half facing down, a tenth of them two-sided), 30% spheres,
+/// 20% point and 10% spot lights in a 100^3 box; power log-uniform over
+/// 1e-2..1e3 (five decades).
+pub fn mixed_scene_from<R: Rng>(n: usize, r: &mut Rand<R>) -> Vec<Emitter> {
+    (0..n)
+        .map(|_| {
+            let c = Vec3::new(
+                r.range(-50.0, 50.0),
+                r.range(-50.0, 50.0),
+                r.range(-50.0, 50.0),
+            );
+            let power = 10f32.powf(r.range(-2.0, 3.0));
+            let kind = r.f();
+            if kind < 0.4 {
+                let normal = if r.f() < 0.5 { -Vec3::Y } else { r.dir() };
+                let mut e = quad(c, normal, r.range(0.05, 2.0), power);
+                e.two_sided = r.f() < 0.1;
+                e
+            } else if kind < 0.7 {
+                Emitter::sphere(c, r.range(0.05, 1.0), power)
+            } else if kind < 0.9 {
+                Emitter::point(c, power)
+            } else {
+                let mut e = Emitter::point(c, power);
+                e.cone = Some(LightCone::spot(r.dir(), r.range(0.1, 1.2)));
+                e
+            }
+        })
+        .collect()
+}
+
+// ---------------------------------------------------------------------------
+// The two rooms
+// ---------------------------------------------------------------------------
+
+/// [`two_rooms_with`] drawn from `Pcg64Mcg`.
+pub fn two_rooms() -> Vec<Emitter> {
+    two_rooms_with::<Pcg64Mcg>()
+}
+
+/// 40 lights at x = -8 and 40 at x = +8; a wall at x = 0 means each half of
+/// the scene sees only its own side's lights. Drawn from an `R` seeded with
+/// 17.
+pub fn two_rooms_with<R: Rng + SeedableRng>() -> Vec<Emitter> {
+    let mut rng = Rand::<R>::seeded(17);
+    (0..80)
+        .map(|i| {
+            let x = if i < 40 { -8.0 } else { 8.0 };
+            Emitter::point(
+                Vec3::new(x, rng.range(-4.0, 4.0), rng.range(-4.0, 4.0)),
+                rng.range(1.0, 3.0),
+            )
+        })
+        .collect()
+}
+
+/// The two rooms' bounds.
+pub fn scene() -> Aabb {
+    Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0))
+}
+
+/// Contribution of light `e` at `p` in the two rooms.
+pub fn value(lights: &[Emitter], e: u32, p: Vec3) -> f32 {
+    let c = lights[e as usize].bounds.center();
+    if (c.x < 0.0) != (p.x < 0.0) {
+        return 0.0;
+    }
+    lights[e as usize].power / (c - p).length_squared().max(1.0)
+}
+
+// ---------------------------------------------------------------------------
+// Chi-square
+// ---------------------------------------------------------------------------
+
+/// ln Gamma(x) for x > 0 (Lanczos, g = 7, 9 terms; ~1e-15 relative).
+pub fn ln_gamma(x: f64) -> f64 {
+    const G: [f64; 9] = [
+        0.999_999_999_999_809_9,
+        676.520_368_121_885_1,
+        -1_259.139_216_722_402_8,
+        771.323_428_777_653_1,
+        -176.615_029_162_140_6,
+        12.507_343_278_686_905,
+        -0.138_571_095_265_720_12,
+        9.984_369_578_019_572e-6,
+        1.505_632_735_149_311_6e-7,
+    ];
+    if x < 0.5 {
+        // Reflection.
+        let pi = std::f64::consts::PI;
+        return (pi / (pi * x).sin()).ln() - ln_gamma(1.0 - x);
+    }
+    let x = x - 1.0;
+    let mut a = G[0];
+    let t = x + 7.5;
+    for (i, g) in G.iter().enumerate().skip(1) {
+        a += g / (x + i as f64);
+    }
+    0.5 * (2.0 * std::f64::consts::PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
+}
+
+/// The regularised upper incomplete gamma function Q(a, x).
+pub fn gamma_q(a: f64, x: f64) -> f64 {
+    if x <= 0.0 {
+        return 1.0;
+    }
+    let front = (-x + a * x.ln() - ln_gamma(a)).exp();
+    if x < a + 1.0 {
+        // Series for P(a, x).
+        let (mut sum, mut term, mut n) = (1.0 / a, 1.0 / a, a);
+        for _ in 0..10_000 {
+            n += 1.0;
+            term *= x / n;
+            sum += term;
+            if term.abs() < sum.abs() * 1e-16 {
+                break;
+            }
+        }
+        1.0 - sum * front
+    } else {
+        // Continued fraction for Q(a, x) (modified Lentz).
+        let tiny = 1e-300;
+        let mut b = x + 1.0 - a;
+        let mut c = 1.0 / tiny;
+        let mut d = 1.0 / b;
+        let mut h = d;
+        for i in 1..10_000 {
+            let an = -(i as f64) * (i as f64 - a);
+            b += 2.0;
+            d = an * d + b;
+            if d.abs() < tiny {
+                d = tiny;
+            }
+            c = b + an / c;
+            if c.abs() < tiny {
+                c = tiny;
+            }
+            d = 1.0 / d;
+            let delta = d * c;
+            h *= delta;
+            if (delta - 1.0).abs() < 1e-16 {
+                break;
+            }
+        }
+        front * h
+    }
+}
