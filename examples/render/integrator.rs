@@ -1,0 +1,341 @@
+//! The path tracer: next-event estimation from a `guiding::LightSampler`,
+//! MIS-combined (power heuristic) with BSDF sampling or, for the guided
+//! methods, with PPG's one-sample mixture of BSDF and guided sampling
+//! (from an SD-tree cell or a combined-field vertex). While training it
+//! splats direct-light estimates into the GLT (or the field's cuts) and,
+//! once a path is done, incident radiance into the SD-tree (or the field's
+//! quadtrees).
+
+use crate::geometry::{NO_EMITTER, offset_origin};
+use crate::lights::luminance;
+use crate::rng::Sampler;
+use crate::scene::Scene;
+use glam::Vec3;
+use guiding::field::{FieldVertex, GuidingField};
+use guiding::glt::Glt;
+use guiding::sd_tree::{SdCell, SdTree};
+use guiding::{LightId, LightSampler, LightTree, ShadingContext};
+
+/// What a path consults and trains.
+#[derive(Clone, Copy)]
+pub struct Guides<'a> {
+    /// Chooses lights for next-event estimation.
+    pub lights: &'a (dyn LightSampler + Sync),
+    /// The Guiding Light Tree to splat direct-light estimates into (the same
+    /// object as `lights` for GLT methods).
+    pub glt: Option<&'a Glt<'a, LightTree>>,
+    /// The SD-tree that guides directions (`ppg`).
+    pub sd_tree: Option<&'a SdTree>,
+    /// The combined field (`ppg-glt`): guides directions and NEE with one
+    /// lookup per vertex (the same object as `lights`).
+    pub field: Option<&'a GuidingField<'a, LightTree>>,
+    /// Whether to record training data this pass.
+    pub train: bool,
+}
+
+/// One guided path vertex awaiting its SD-tree splat.
+#[derive(Clone, Copy, Debug)]
+pub struct Record {
+    pos: Vec3,
+    dir: Vec3,
+    pdf: f32,
+    bsdf_pdf: f32,
+    guide_pdf: f32,
+    weight: Vec3,
+    beta_after: Vec3,
+    radiance: Vec3,
+}
+
+/// The last scattering vertex, for MIS at the next emitter hit.
+#[derive(Clone, Copy)]
+struct Vertex {
+    pos: Vec3,
+    normal: Vec3,
+    pdf_dir: f32,
+    delta: bool,
+}
+
+/// Directional guiding at one vertex: an SD-tree cell or a field vertex.
+#[derive(Clone, Copy)]
+enum DirGuide<'a> {
+    Sd(&'a SdCell),
+    Field(FieldVertex<'a, 'a, LightTree>),
+}
+
+impl DirGuide<'_> {
+    /// Probability of sampling the BSDF rather than the guide.
+    #[inline]
+    fn fraction(&self) -> f32 {
+        match self {
+            Self::Sd(c) => c.bsdf_fraction(),
+            Self::Field(v) => v.bsdf_fraction(),
+        }
+    }
+
+    /// The guide's solid-angle pdf of `dir`.
+    #[inline]
+    fn pdf(&self, dir: Vec3) -> f32 {
+        match self {
+            Self::Sd(c) => c.directions().pdf(dir),
+            Self::Field(v) => v.direction_pdf(dir),
+        }
+    }
+
+    /// A direction from the guide.
+    #[inline]
+    fn sample(&self, u: [f32; 2]) -> Vec3 {
+        match self {
+            Self::Sd(c) => c.directions().sample(u).0,
+            Self::Field(v) => v.sample_direction(u).0,
+        }
+    }
+}
+
+/// Records a direct-light estimate for `light` seen from `p` (the GLT's
+/// splat), into the GLT or the field.
+#[inline]
+fn splat_light(guides: &Guides, p: Vec3, light: LightId, value: f32, s: &mut Sampler) {
+    if let Some(glt) = guides.glt {
+        glt.splat(p, light, value, s.rng());
+    } else if let Some(field) = guides.field {
+        field.splat_light(p, light, value, s.rng());
+    }
+}
+
+/// Power heuristic weight of technique `a` against `b`.
+#[inline]
+fn mis(a: f32, b: f32) -> f32 {
+    if a.is_infinite() {
+        return 1.0;
+    }
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 > 0.0 { a2 / (a2 + b2) } else { 0.0 }
+}
+
+/// Componentwise `c / d`, 0 where `d` is 0.
+#[inline]
+fn safe_div(c: Vec3, d: Vec3) -> Vec3 {
+    Vec3::new(
+        if d.x > 0.0 { c.x / d.x } else { 0.0 },
+        if d.y > 0.0 { c.y / d.y } else { 0.0 },
+        if d.z > 0.0 { c.z / d.z } else { 0.0 },
+    )
+}
+
+/// Adds a contribution to the pixel and to the incident radiance of every
+/// recorded vertex before it.
+#[inline]
+fn contribute(l: &mut Vec3, records: &mut [Record], c: Vec3) {
+    *l += c;
+    for r in records.iter_mut() {
+        r.radiance += safe_div(c, r.beta_after);
+    }
+}
+
+/// The radiance arriving at the camera along `origin + t dir`.
+/// `records` is scratch space reused between paths.
+pub fn radiance(
+    scene: &Scene,
+    guides: &Guides,
+    mut origin: Vec3,
+    mut dir: Vec3,
+    s: &mut Sampler,
+    records: &mut Vec<Record>,
+) -> Vec3 {
+    let max_depth = scene.effects.max_depth;
+    let train_light = guides.train && (guides.glt.is_some() || guides.field.is_some());
+    let train_sd = guides.train && (guides.sd_tree.is_some() || guides.field.is_some());
+    let mut l = Vec3::ZERO;
+    let mut beta = Vec3::ONE;
+    let mut prev: Option<Vertex> = None;
+    // True while every vertex so far was a delta (specular) one.
+    let mut specular_chain = true;
+    records.clear();
+    for depth in 0..max_depth {
+        let Some(hit) = scene.intersect(origin, dir) else {
+            if let Some(env) = &scene.environment {
+                let (w, pdf_dir) = match prev {
+                    Some(v) if !v.delta => {
+                        let ctx = ShadingContext::on_surface(v.pos, v.normal);
+                        let p_light =
+                            guides.lights.pmf(&ctx, LightId::Environment) * env.pdf(v.normal, dir);
+                        (mis(v.pdf_dir, p_light), v.pdf_dir)
+                    }
+                    _ => (1.0, 0.0),
+                };
+                contribute(&mut l, records, beta * env.radiance * w);
+                if let (true, Some(v)) = (train_light, prev)
+                    && !v.delta
+                    && pdf_dir > 0.0
+                {
+                    let value = luminance(env.radiance) * w / pdf_dir;
+                    if value > 0.0 {
+                        splat_light(guides, v.pos, LightId::Environment, value, s);
+                    }
+                }
+            }
+            break;
+        };
+        let prim = *scene.primitive(&hit);
+        let p = origin + dir * hit.t;
+        let ng = prim.normal(p);
+        // "Directly visible" includes through specular (delta) chains.
+        let seen_by_camera = prev.is_none_or(|v| v.delta && specular_chain);
+        if prim.emitter != NO_EMITTER && (scene.camera_sees_emitters || !seen_by_camera) {
+            let light = &scene.lights[prim.emitter as usize];
+            let le = light.emitted(dir, ng);
+            if le.max_element() > 0.0 {
+                let id = LightId::Emitter(prim.emitter);
+                let (w, pdf_dir) = match prev {
+                    Some(v) if !v.delta => {
+                        let ctx = ShadingContext::on_surface(v.pos, v.normal);
+                        let dist = (p - v.pos).length();
+                        let p_light = guides.lights.pmf(&ctx, id) * light.pdf(v.pos, dir, dist, ng);
+                        (mis(v.pdf_dir, p_light), v.pdf_dir)
+                    }
+                    _ => (1.0, 0.0),
+                };
+                contribute(&mut l, records, beta * le * w);
+                if let (true, Some(v)) = (train_light, prev)
+                    && !v.delta
+                    && pdf_dir > 0.0
+                {
+                    let value = luminance(le) * w / pdf_dir;
+                    if value > 0.0 {
+                        splat_light(guides, v.pos, id, value, s);
+                    }
+                }
+            }
+        }
+        let mat = scene.materials[prim.material as usize];
+        if mat.is_black() || depth + 1 >= max_depth {
+            break;
+        }
+        let wo = -dir;
+        if mat.is_delta() {
+            let Some(bs) = mat.sample(ng, wo, s.next2(), s.next()) else {
+                break;
+            };
+            beta *= bs.weight;
+            prev = Some(Vertex {
+                pos: p,
+                normal: ng,
+                pdf_dir: 0.0,
+                delta: true,
+            });
+            origin = offset_origin(p, ng, bs.wi);
+            dir = bs.wi;
+            continue;
+        }
+        specular_chain = false;
+        let n = if ng.dot(wo) < 0.0 { -ng } else { ng };
+        let ctx = ShadingContext::on_surface(p, n);
+        let field_vertex = guides.field.and_then(|f| f.vertex(p));
+        let cell = match (field_vertex, guides.sd_tree) {
+            (Some(v), _) => Some(DirGuide::Field(v)),
+            (None, Some(t)) => t.cell_at(p).map(DirGuide::Sd),
+            (None, None) => None,
+        };
+        let frac = cell.map_or(1.0, |c| c.fraction());
+        let dir_pdf = |wi: Vec3, bsdf_pdf: f32| match cell {
+            Some(c) => {
+                let g = c.pdf(wi);
+                (frac * bsdf_pdf + (1.0 - frac) * g, g)
+            }
+            None => (bsdf_pdf, 0.0),
+        };
+        // The field's vertex samples its cell's cut without a second lookup.
+        let nee: &dyn LightSampler = match &field_vertex {
+            Some(v) => v,
+            None => guides.lights,
+        };
+
+        // Next-event estimation.
+        if let Some(ls) = nee.sample(&ctx, s.next()) {
+            let u = s.next2();
+            let point = match ls.light {
+                LightId::Emitter(e) => scene.lights[e as usize].sample(p, u),
+                LightId::Environment => scene.environment.as_ref().and_then(|env| env.sample(n, u)),
+            };
+            if let Some(lp) = point {
+                let (f, bsdf_pdf) = mat.eval(n, wo, lp.wi);
+                if f.max_element() > 0.0 && lp.pdf > 0.0 && lp.radiance.max_element() > 0.0 {
+                    let p_light = ls.pmf * lp.pdf;
+                    let (p_dir, _) = dir_pdf(lp.wi, bsdf_pdf);
+                    let w = mis(p_light, p_dir);
+                    let o = offset_origin(p, n, lp.wi);
+                    let target = match ls.light {
+                        LightId::Emitter(e) => e,
+                        LightId::Environment => NO_EMITTER,
+                    };
+                    if !scene.occluded(o, lp.wi, lp.dist, target) {
+                        let c = beta * f * lp.radiance * (w / p_light);
+                        if c.is_finite() {
+                            contribute(&mut l, records, c);
+                            if train_light {
+                                let value = luminance(lp.radiance) * w / p_light;
+                                splat_light(guides, p, ls.light, value, s);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+
+        // Continue the path: BSDF sampling, or PPG's mixture.
+        let u_tech = s.next();
+        let (u2, u_lobe) = (s.next2(), s.next());
+        let (wi, f_cos, bsdf_pdf) = if u_tech < frac || cell.is_none() {
+            let Some(bs) = mat.sample(n, wo, u2, u_lobe) else {
+                break;
+            };
+            (bs.wi, bs.weight * bs.pdf, bs.pdf)
+        } else {
+            let Some(c) = cell else { break };
+            let wi = c.sample([u2.x, u2.y]);
+            let (f, bsdf_pdf) = mat.eval(n, wo, wi);
+            (wi, f, bsdf_pdf)
+        };
+        let (pdf, guide_pdf) = dir_pdf(wi, bsdf_pdf);
+        if pdf.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || f_cos.max_element() <= 0.0
+        {
+            break;
+        }
+        let weight = f_cos / pdf;
+        beta *= weight;
+        if train_sd {
+            records.push(Record {
+                pos: p,
+                dir: wi,
+                pdf,
+                bsdf_pdf,
+                guide_pdf,
+                weight,
+                beta_after: beta,
+                radiance: Vec3::ZERO,
+            });
+        }
+        prev = Some(Vertex {
+            pos: p,
+            normal: n,
+            pdf_dir: pdf,
+            delta: false,
+        });
+        origin = offset_origin(p, n, wi);
+        dir = wi;
+    }
+    if let (true, Some(t)) = (train_sd, guides.sd_tree) {
+        for r in records.iter() {
+            if r.radiance.is_finite() {
+                t.splat(r.pos, r.dir, luminance(r.radiance), r.pdf, s.rng());
+                t.record_fraction(
+                    r.pos,
+                    r.bsdf_pdf,
+                    r.guide_pdf,
+                    luminance(r.weight * r.radiance),
+                );
+            }
+        }
+    }
+    if l.is_finite() { l } else { Vec3::ZERO }
+}

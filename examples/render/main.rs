@@ -1,0 +1,265 @@
+//! `render`: a small CPU path tracer that uses only `guiding`'s public API,
+//! the way an outside renderer would, to compare light-sampling and
+//! guiding methods on code-generated analogues of the paper's scenes.
+//!
+//! ```text
+//! cargo run --release --example render                     # default job
+//! cargo run --release --example render -- --scene ring --method pt-uniform,ppg-glt --seconds 30 --json out.json
+//! ```
+//!
+//! One concept per file: `cli` (flags), `scenes/` (scene generators),
+//! `scene` (scene container, effect declarations), `geometry` + `bvh`
+//! (primitives, obvhs ray casting), `materials`, `lights`, `camera`,
+//! `integrator` (the path tracer and its training splats), `methods` (which
+//! crate objects a method uses), `run` (passes, training schedule,
+//! combination), `film` (EXR/PNG), `reference` (cache), `metrics`,
+//! `report` (JSON, table), `sheet` (comparison sheet).
+
+mod bvh;
+mod camera;
+mod cli;
+mod film;
+mod geometry;
+mod integrator;
+mod lights;
+mod materials;
+mod methods;
+mod metrics;
+mod reference;
+mod report;
+mod rng;
+mod run;
+mod scene;
+mod scenes;
+mod sheet;
+
+use clap::Parser;
+use methods::{GuideParams, Method};
+use report::Record;
+use run::{Budget, Settings};
+use std::path::Path;
+use std::process::ExitCode;
+use std::time::Instant;
+
+fn main() -> ExitCode {
+    let args = cli::Args::parse();
+    match run_all(&args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Parses the scene and method lists.
+fn selection(args: &cli::Args) -> Result<(Vec<String>, Vec<Method>), String> {
+    let scenes: Vec<String> = if args.scene.iter().any(|s| s == "all") {
+        scenes::NAMES.iter().map(|s| s.to_string()).collect()
+    } else {
+        args.scene.clone()
+    };
+    for s in &scenes {
+        if !scenes::NAMES.contains(&s.as_str()) {
+            return Err(format!(
+                "unknown scene {s:?} (known: {})",
+                scenes::NAMES.join(", ")
+            ));
+        }
+    }
+    let methods = if args.method.is_empty() {
+        Method::MAIN.to_vec()
+    } else if args.method.iter().any(|m| m == "all") {
+        Method::ALL.to_vec()
+    } else {
+        args.method
+            .iter()
+            .map(|m| Method::parse(m).ok_or_else(|| format!("unknown method {m:?}")))
+            .collect::<Result<_, _>>()?
+    };
+    Ok((scenes, methods))
+}
+
+fn run_all(args: &cli::Args) -> Result<(), String> {
+    if let Some(n) = args.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .map_err(|e| e.to_string())?;
+    }
+    let (scene_names, methods) = selection(args)?;
+    let reference_method = Method::parse(&args.reference_method)
+        .ok_or_else(|| format!("unknown reference method {:?}", args.reference_method))?;
+    let budget = match (args.spp, args.seconds) {
+        (Some(n), _) => Budget::Spp(n.max(1)),
+        (None, Some(s)) => Budget::Seconds(s),
+        (None, None) => Budget::Seconds(20.0),
+    };
+    let reference_budget = match (args.reference_spp, args.reference_seconds, budget) {
+        (Some(n), _, _) => Budget::Spp(n),
+        (None, Some(s), _) => Budget::Seconds(s),
+        (None, None, Budget::Seconds(s)) => Budget::Seconds(4.0 * s),
+        (None, None, Budget::Spp(_)) => Budget::Seconds(80.0),
+    };
+    std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
+    let size = if args.small {
+        scenes::Size::Small
+    } else {
+        scenes::Size::Full
+    };
+    let settings = Settings {
+        width: args.width,
+        height: args.height,
+        budget,
+        params: GuideParams {
+            sigma: args.sigma,
+            spatial_threshold: args.spatial_threshold(),
+        },
+        seed: args.seed,
+        progress: !args.quiet,
+    };
+    let mut all = Vec::new();
+    for name in &scene_names {
+        let records = run_scene(
+            args,
+            name,
+            size,
+            &methods,
+            &settings,
+            reference_method,
+            reference_budget,
+        )?;
+        println!("{}", report::table(&records));
+        all.extend(records);
+    }
+    if let Some(path) = &args.json {
+        std::fs::write(path, report::to_json(&all))
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+fn run_scene(
+    args: &cli::Args,
+    name: &str,
+    size: scenes::Size,
+    methods: &[Method],
+    settings: &Settings,
+    reference_method: Method,
+    reference_budget: Budget,
+) -> Result<Vec<Record>, String> {
+    let t = Instant::now();
+    let mut scene = scenes::build(name, size).ok_or_else(|| format!("unknown scene {name}"))?;
+    if let Some(d) = args.max_depth {
+        scene.effects.max_depth = d;
+        scene.fingerprint = rng::mix64(scene.fingerprint ^ u64::from(d));
+    }
+    println!(
+        "scene {name}: {} primitives, {} emitters, light tree {:.1} MB; effects: {}; built in {:.1} s",
+        scene.bvh.primitives().len(),
+        scene.lights.len(),
+        scene.light_tree.bytes() as f64 / 1e6,
+        scene.effects.describe(),
+        t.elapsed().as_secs_f64()
+    );
+    let reference = reference::load_or_render(
+        &scene,
+        &args.out,
+        settings,
+        reference_method,
+        reference_budget,
+        args.rebuild_reference,
+    )?;
+    println!(
+        "reference: {} ({}){}",
+        reference.provenance,
+        reference::cache_stem(&args.out, &scene, settings.width, settings.height).display(),
+        if reference.cached { ", cached" } else { "" }
+    );
+    let exposure = film::auto_exposure(reference.mean);
+    let dir = args.out.join(name);
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let mut records = Vec::new();
+    let mut rendered = Vec::new();
+    for &method in methods {
+        let r = run::render(&scene, method, settings);
+        let e = metrics::errors(&r.image, &reference);
+        write_outputs(&dir, method.name(), &r, exposure)?;
+        records.push(Record {
+            scene: name.to_string(),
+            method: method.name().to_string(),
+            width: r.width,
+            height: r.height,
+            spp: r.spp,
+            spp_final: r.spp_final,
+            seconds: r.seconds,
+            rmse: e.rmse,
+            relmse: e.relmse,
+            efficiency: metrics::efficiency(e.relmse, r.seconds),
+            rmse_raw: e.rmse_raw,
+            relmse_raw: e.relmse_raw,
+            reference_relmse: e.relmse_floor,
+            mean: r.mean,
+            mean_error: r.mean_error,
+            reference_mean: reference.mean,
+            sdtree_bytes: r.sd_tree_bytes,
+            glt_bytes: r.glt_bytes,
+            emitters: scene.lights.len(),
+            iterations: r.iterations,
+        });
+        rendered.push((method, r, e));
+    }
+    let mut panels = vec![sheet::Panel {
+        image: &reference.image,
+        lines: vec![
+            "reference".into(),
+            reference.provenance.clone().replace(" spp", "spp"),
+        ],
+    }];
+    for (method, r, e) in &rendered {
+        panels.push(sheet::Panel {
+            image: &r.image,
+            lines: vec![
+                method.name().to_string(),
+                format!("rmse {:.4}", e.rmse),
+                format!("{} spp {:.0} s", r.spp, r.seconds),
+            ],
+        });
+    }
+    let sheet_path = dir.join("comparison.png");
+    sheet::write_sheet(
+        &sheet_path,
+        settings.width,
+        settings.height,
+        exposure,
+        &panels,
+    )?;
+    film::write_png(
+        &dir.join("reference.png"),
+        settings.width,
+        settings.height,
+        &film::tone_map(&reference.image, exposure),
+    )?;
+    println!(
+        "{name}: images in {}, comparison sheet {}",
+        dir.display(),
+        sheet_path.display()
+    );
+    Ok(records)
+}
+
+fn write_outputs(dir: &Path, name: &str, r: &run::Rendered, exposure: f32) -> Result<(), String> {
+    film::write_exr(
+        &dir.join(format!("{name}.exr")),
+        r.width,
+        r.height,
+        &r.image,
+    )?;
+    film::write_png(
+        &dir.join(format!("{name}.png")),
+        r.width,
+        r.height,
+        &film::tone_map(&r.image, exposure),
+    )
+}

@@ -1,0 +1,187 @@
+//! The rendering methods compared, and the crate objects each one needs:
+//! which light sampler drives next-event estimation, and whether a Guiding
+//! Light Tree and/or an SD-tree is trained.
+
+use crate::scene::Scene;
+use guiding::field::{FieldConfig, GuidingField};
+use guiding::glt::{CutConfig, Glt, GltConfig};
+use guiding::light_sampler::{
+    ImportanceTreeSampler, PowerSampler, UniformSampler, WithEnvironment,
+};
+use guiding::sd_tree::{SdTree, SdTreeConfig};
+use guiding::{LightSampler, LightTree};
+
+/// A way to render: a light sampler for NEE, optionally with PPG's
+/// directional guiding.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// Path tracing, NEE choosing emitters uniformly.
+    PtUniform,
+    /// Path tracing, NEE by emitter power.
+    PtPower,
+    /// Path tracing, NEE by the light BVH's importance (Estevez-Kulla /
+    /// pbrt-v4).
+    PtBvh,
+    /// Path tracing, NEE by the Guiding Light Tree (no directional guiding).
+    PtGlt,
+    /// Practical Path Guiding (SD-tree) with uniform NEE: the paper's
+    /// baseline.
+    Ppg,
+    /// Practical Path Guiding with GLT NEE, the paper's method: one
+    /// spatial tree whose cells hold a quadtree and a cut
+    /// (`guiding::field::GuidingField`).
+    PpgGlt,
+}
+
+impl Method {
+    /// Every method, in table order.
+    pub const ALL: [Method; 6] = [
+        Method::PtUniform,
+        Method::PtPower,
+        Method::PtBvh,
+        Method::PtGlt,
+        Method::Ppg,
+        Method::PpgGlt,
+    ];
+
+    /// The methods a run without arguments compares.
+    pub const MAIN: [Method; 4] = [Method::PtBvh, Method::PtGlt, Method::Ppg, Method::PpgGlt];
+
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::PtUniform => "pt-uniform",
+            Method::PtPower => "pt-power",
+            Method::PtBvh => "pt-bvh",
+            Method::PtGlt => "pt-glt",
+            Method::Ppg => "ppg",
+            Method::PpgGlt => "ppg-glt",
+        }
+    }
+
+    /// The method called `name`.
+    pub fn parse(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// Trains a Guiding Light Tree on its own spatial tree.
+    pub fn uses_glt(self) -> bool {
+        matches!(self, Method::PtGlt)
+    }
+
+    /// Trains an SD-tree for directional guiding.
+    pub fn uses_sd_tree(self) -> bool {
+        matches!(self, Method::Ppg)
+    }
+
+    /// Trains the combined field (quadtree and cut per cell).
+    pub fn uses_field(self) -> bool {
+        matches!(self, Method::PpgGlt)
+    }
+
+    /// Renders in training iterations (PPG's schedule).
+    pub fn is_trained(self) -> bool {
+        self.uses_glt() || self.uses_sd_tree() || self.uses_field()
+    }
+}
+
+/// Parameters of the learned structures.
+#[derive(Clone, Copy, Debug)]
+pub struct GuideParams {
+    /// The GLT's split threshold sigma.
+    pub sigma: f64,
+    /// PPG's spatial split threshold `c`, for the SD-tree and the GLT's
+    /// spatial tree.
+    pub spatial_threshold: f64,
+}
+
+/// A fixed (untrained) light sampler for `method`, with the scene's
+/// environment light beside it; `None` for GLT methods.
+pub fn fixed_sampler<'a>(
+    scene: &'a Scene,
+    method: Method,
+) -> Option<Box<dyn LightSampler + Sync + 'a>> {
+    let env = scene.environment.map(|_| scene.environment_probability);
+    fn wrap<'a, S: LightSampler + Sync + 'a>(
+        s: S,
+        env: Option<f32>,
+    ) -> Box<dyn LightSampler + Sync + 'a> {
+        match env {
+            Some(p) => Box::new(WithEnvironment::new(s, p)),
+            None => Box::new(s),
+        }
+    }
+    match method {
+        Method::PtUniform | Method::Ppg => Some(wrap(UniformSampler::new(scene.lights.len()), env)),
+        Method::PtPower => Some(wrap(PowerSampler::new(&scene.emitters), env)),
+        Method::PtBvh => Some(wrap(ImportanceTreeSampler::new(&scene.light_tree), env)),
+        Method::PtGlt | Method::PpgGlt => None,
+    }
+}
+
+/// The cuts' configuration: sigma, and the environment light's prior.
+fn cut_config(scene: &Scene, params: &GuideParams) -> CutConfig {
+    CutConfig {
+        sigma: params.sigma,
+        environment: scene
+            .environment
+            .map(|_| f64::from(scene.environment_probability)),
+        ..CutConfig::default()
+    }
+}
+
+/// Müller's improved SD-tree configuration (stochastic box filter, box
+/// directional filter, learned BSDF fraction) with the given spatial
+/// threshold.
+fn sd_config(params: &GuideParams) -> SdTreeConfig {
+    SdTreeConfig {
+        spatial_threshold: params.spatial_threshold as f32,
+        ..SdTreeConfig::improved()
+    }
+}
+
+/// A fresh combined field over the scene, if `method` uses one.
+pub fn new_field<'a>(
+    scene: &'a Scene,
+    method: Method,
+    params: &GuideParams,
+) -> Option<GuidingField<'a, LightTree>> {
+    if !method.uses_field() {
+        return None;
+    }
+    let config = FieldConfig {
+        sd: sd_config(params),
+        cut: cut_config(scene, params),
+        ..FieldConfig::default()
+    };
+    Some(
+        GuidingField::new(&scene.light_tree, scene.bounds, config)
+            .expect("scene bounds are finite"),
+    )
+}
+
+/// A fresh Guiding Light Tree over the scene, if `method` uses one.
+pub fn new_glt<'a>(
+    scene: &'a Scene,
+    method: Method,
+    params: &GuideParams,
+) -> Option<Glt<'a, LightTree>> {
+    if !method.uses_glt() {
+        return None;
+    }
+    let config = GltConfig {
+        cut: cut_config(scene, params),
+        spatial_threshold: params.spatial_threshold,
+        spatial_budget: None,
+    };
+    Some(Glt::new(&scene.light_tree, scene.bounds, config).expect("scene bounds are finite"))
+}
+
+/// A fresh SD-tree over the scene, if `method` uses one (see `sd_config`).
+pub fn new_sd_tree(scene: &Scene, method: Method, params: &GuideParams) -> Option<SdTree> {
+    if !method.uses_sd_tree() {
+        return None;
+    }
+    let config = sd_config(params);
+    Some(SdTree::new(scene.bounds, config).expect("scene bounds are finite"))
+}

@@ -1,0 +1,300 @@
+//! Runs one method on one scene within a budget: passes of one sample per
+//! pixel, parallel over tiles; trained methods follow the crate's iteration
+//! schedule (2^k passes, the last taking the rest) and combine their last
+//! iterations by inverse variance, as PPG does.
+
+use crate::integrator::{Guides, radiance};
+use crate::lights::luminance;
+use crate::methods::{GuideParams, Method, fixed_sampler, new_field, new_glt, new_sd_tree};
+use crate::rng::Sampler;
+use crate::scene::Scene;
+use glam::Vec3;
+use guiding::LightSampler;
+use guiding::schedule::{
+    InverseVarianceCombiner, Iteration, MAX_COMBINED, PassStats, next_iteration,
+    next_iteration_by_time,
+};
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use std::collections::VecDeque;
+use std::time::Instant;
+
+/// How long a method may render.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Budget {
+    /// This many samples per pixel in all (training included).
+    Spp(u64),
+    /// This much wall-clock time (training included).
+    Seconds(f64),
+}
+
+/// What a render is asked to do.
+#[derive(Clone, Debug)]
+pub struct Settings {
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Budget.
+    pub budget: Budget,
+    /// Learned-structure parameters.
+    pub params: GuideParams,
+    /// Seed of all random streams.
+    pub seed: u64,
+    /// Draw a progress bar.
+    pub progress: bool,
+}
+
+/// A finished render.
+#[derive(Clone, Debug)]
+pub struct Rendered {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Linear RGB, row-major.
+    pub image: Vec<Vec3>,
+    /// Estimated variance of each pixel's value (per channel).
+    pub variance: Vec<Vec3>,
+    /// Samples per pixel rendered, training iterations included.
+    pub spp: u64,
+    /// Samples per pixel of the iterations the image combines.
+    pub spp_final: u64,
+    /// Wall-clock seconds, training and refinement included.
+    pub seconds: f64,
+    /// Mean luminance of the image.
+    pub mean: f64,
+    /// Standard error of `mean`.
+    pub mean_error: f64,
+    /// Training iterations (1 for untrained methods).
+    pub iterations: u32,
+    /// Bytes of the SD-tree at the end (0 if none).
+    pub sd_tree_bytes: usize,
+    /// Bytes of the GLT at the end (0 if none).
+    pub glt_bytes: usize,
+}
+
+const TILE: u32 = 16;
+
+/// Renders one pass (one sample per pixel) into `out` (RGB triples).
+fn render_pass(scene: &Scene, guides: &Guides, settings: &Settings, pass: u64, out: &mut [f32]) {
+    let (w, h) = (settings.width, settings.height);
+    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
+        .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
+        .collect();
+    let results: Vec<Vec<Vec3>> = tiles
+        .par_iter()
+        .enumerate()
+        .map(|(i, &(x0, y0))| {
+            let mut s = Sampler::new(settings.seed, pass, i as u64);
+            let mut records = Vec::new();
+            let mut px = Vec::with_capacity((TILE * TILE) as usize);
+            for y in y0..(y0 + TILE).min(h) {
+                for x in x0..(x0 + TILE).min(w) {
+                    let j = s.next2();
+                    let dir = scene.camera.direction(x as f32 + j.x, y as f32 + j.y, w, h);
+                    px.push(radiance(
+                        scene,
+                        guides,
+                        scene.camera.eye,
+                        dir,
+                        &mut s,
+                        &mut records,
+                    ));
+                }
+            }
+            px
+        })
+        .collect();
+    for (&(x0, y0), px) in tiles.iter().zip(&results) {
+        let mut k = 0;
+        for y in y0..(y0 + TILE).min(h) {
+            for x in x0..(x0 + TILE).min(w) {
+                let o = 3 * (y * w + x) as usize;
+                out[o..o + 3].copy_from_slice(&px[k].to_array());
+                k += 1;
+            }
+        }
+    }
+}
+
+/// One finished iteration: its statistics and those of its image mean.
+struct Done {
+    stats: PassStats,
+    mean_var: f64,
+}
+
+/// Renders `scene` with `method` within `settings.budget`.
+pub fn render(scene: &Scene, method: Method, settings: &Settings) -> Rendered {
+    let start = Instant::now();
+    let (w, h) = (settings.width, settings.height);
+    let len = (3 * w * h) as usize;
+    let fixed = fixed_sampler(scene, method);
+    let mut glt = new_glt(scene, method, &settings.params);
+    let mut sd_tree = new_sd_tree(scene, method, &settings.params);
+    let mut field = new_field(scene, method, &settings.params);
+    let trained = method.is_trained();
+    let bar = progress_bar(settings, method);
+    let mut combiner = InverseVarianceCombiner::new();
+    let mut history: VecDeque<Done> = VecDeque::new();
+    let mut pass_buf = vec![0.0f32; len];
+    let (mut k, mut spp, mut sec_per_pass) = (0u32, 0u64, 0.0f64);
+    loop {
+        let elapsed = start.elapsed().as_secs_f64();
+        let it = match (trained, settings.budget) {
+            (true, Budget::Spp(n)) => next_iteration(k, n - spp),
+            (true, Budget::Seconds(s)) => next_iteration_by_time(k, s - elapsed, sec_per_pass),
+            (false, Budget::Spp(n)) => (spp < n).then_some(Iteration {
+                index: 0,
+                passes: n,
+                is_last: true,
+            }),
+            (false, Budget::Seconds(_)) => Some(Iteration {
+                index: 0,
+                passes: u64::MAX,
+                is_last: true,
+            }),
+        };
+        let Some(it) = it else { break };
+        // Under a time budget the last iteration renders until time is up.
+        let passes = match settings.budget {
+            Budget::Seconds(_) if it.is_last => u64::MAX,
+            _ => it.passes,
+        };
+        let mut stats = PassStats::new(len);
+        let (mut m_sum, mut m_sq) = (0.0f64, 0.0f64);
+        let it_start = Instant::now();
+        for pass in 0..passes {
+            if let Budget::Seconds(s) = settings.budget {
+                let done = start.elapsed().as_secs_f64();
+                let per = if pass > 0 {
+                    it_start.elapsed().as_secs_f64() / pass as f64
+                } else {
+                    0.0
+                };
+                if pass > 0 && it.is_last && done + 0.5 * per > s {
+                    break;
+                }
+                bar.set_position((done * 1000.0) as u64);
+            }
+            let lights: &(dyn LightSampler + Sync) = match (&fixed, &glt, &field) {
+                (Some(f), _, _) => f.as_ref(),
+                (None, Some(g), _) => g,
+                (None, None, Some(f)) => f,
+                (None, None, None) => unreachable!("every method has a light sampler"),
+            };
+            let guides = Guides {
+                lights,
+                glt: glt.as_ref(),
+                sd_tree: sd_tree.as_ref(),
+                field: field.as_ref(),
+                train: trained && !it.is_last,
+            };
+            render_pass(scene, &guides, settings, spp, &mut pass_buf);
+            stats.add_pass(&pass_buf);
+            let m = mean_luminance(&pass_buf);
+            m_sum += m;
+            m_sq += m * m;
+            spp += 1;
+            if let Budget::Spp(_) = settings.budget {
+                bar.set_position(spp);
+            }
+        }
+        let n = stats.passes();
+        if n == 0 {
+            break;
+        }
+        sec_per_pass = it_start.elapsed().as_secs_f64() / n as f64;
+        let mean = m_sum / n as f64;
+        let mean_var = if n > 1 {
+            ((m_sq - n as f64 * mean * mean) / ((n - 1) as f64 * n as f64)).max(0.0)
+        } else {
+            f64::NAN
+        };
+        combiner.push_stats(&stats);
+        if history.len() == MAX_COMBINED {
+            history.pop_front();
+        }
+        history.push_back(Done { stats, mean_var });
+        if it.is_last {
+            break;
+        }
+        if let Some(g) = glt.as_mut() {
+            g.refine();
+        }
+        if let Some(t) = sd_tree.as_mut() {
+            t.refine();
+        }
+        if let Some(f) = field.as_mut() {
+            f.refine();
+        }
+        k += 1;
+    }
+    bar.finish_and_clear();
+    let seconds = start.elapsed().as_secs_f64();
+    let flat = combiner.combine();
+    let weights = combiner.weights();
+    let mut variance = vec![Vec3::ZERO; (w * h) as usize];
+    let (mut mean_error2, mut spp_final) = (0.0f64, 0u64);
+    for (done, &wt) in history.iter().zip(&weights) {
+        if wt <= 0.0 {
+            continue;
+        }
+        spp_final += done.stats.passes();
+        mean_error2 += wt * wt * done.mean_var;
+        for (i, v) in variance.iter_mut().enumerate() {
+            for c in 0..3 {
+                let var = done.stats.variance_of_mean(3 * i + c).unwrap_or(0.0);
+                v[c] += (wt * wt * var) as f32;
+            }
+        }
+    }
+    let image: Vec<Vec3> = flat.chunks_exact(3).map(Vec3::from_slice).collect();
+    Rendered {
+        width: w,
+        height: h,
+        mean: mean_luminance(&flat),
+        image,
+        variance,
+        spp,
+        spp_final,
+        seconds,
+        mean_error: mean_error2.sqrt(),
+        iterations: k + 1,
+        // For the field: the cuts are the GLT's share, the rest (spatial
+        // tree, quadtrees, statistics) the SD-tree's.
+        sd_tree_bytes: sd_tree.as_ref().map_or(0, |t| t.memory().total())
+            + field.as_ref().map_or(0, |f| {
+                let m = f.memory();
+                m.total() - m.cut_bytes()
+            }),
+        glt_bytes: glt.as_ref().map_or(0, |g| g.memory().total())
+            + field.as_ref().map_or(0, |f| f.memory().cut_bytes()),
+    }
+}
+
+/// Mean luminance of an RGB buffer.
+fn mean_luminance(rgb: &[f32]) -> f64 {
+    let n = (rgb.len() / 3).max(1) as f64;
+    rgb.chunks_exact(3)
+        .map(|c| f64::from(luminance(Vec3::from_slice(c))))
+        .sum::<f64>()
+        / n
+}
+
+fn progress_bar(settings: &Settings, method: Method) -> ProgressBar {
+    if !settings.progress {
+        return ProgressBar::hidden();
+    }
+    let (len, unit) = match settings.budget {
+        Budget::Spp(n) => (n, "spp"),
+        Budget::Seconds(s) => ((s * 1000.0) as u64, "ms"),
+    };
+    let bar = ProgressBar::new(len);
+    let template = format!("{{msg:>10}} [{{bar:40}}] {{pos}}/{{len}} {unit}");
+    if let Ok(style) = ProgressStyle::with_template(&template) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.set_message(method.name());
+    bar
+}

@@ -1,0 +1,70 @@
+//! The scenes, generated in code: analogues of the paper's, plus a smoke
+//! test box.
+
+mod city;
+mod cornell;
+mod few_lights;
+mod occlusion;
+mod pool;
+mod ring;
+pub mod shapes;
+mod torus;
+
+use crate::scene::Scene;
+
+/// How big to make a scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Size {
+    /// As documented (the analogue of the paper's scene).
+    Full,
+    /// Fewer lights and objects, for fast tests.
+    Small,
+}
+
+/// Every scene name, in the order `--scene all` renders them.
+pub const NAMES: &[&str] = &[
+    "ring",
+    "city",
+    "pool",
+    "torus",
+    "occlusion",
+    "few-lights",
+    "box",
+];
+
+/// The scene a run without arguments renders.
+pub const DEFAULT: &str = "ring";
+
+/// Builds the scene called `name`; `None` for an unknown name.
+pub fn build(name: &str, size: Size) -> Option<Scene> {
+    Some(match name {
+        "ring" => ring::build(size),
+        "city" => city::build(size),
+        "pool" => pool::build(size),
+        "torus" => torus::build(size),
+        "occlusion" => occlusion::build(size),
+        "few-lights" => few_lights::build(size),
+        "box" => cornell::build(size),
+        _ => return None,
+    })
+}
+
+/// A deterministic stream of uniform numbers for scene generation.
+pub struct Dice(crate::rng::Sampler);
+
+impl Dice {
+    /// The stream for `seed`.
+    pub fn new(seed: u64) -> Self {
+        Self(crate::rng::Sampler::new(seed, u64::MAX, 0))
+    }
+
+    /// A number in `[lo, hi)`.
+    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.0.next()
+    }
+
+    /// True with probability `p`.
+    pub fn chance(&mut self, p: f32) -> bool {
+        self.0.next() < p
+    }
+}

@@ -1,0 +1,144 @@
+//! The `render` example's integrator gives the same image with every
+//! method: per-method image means (whole image and quadrants) agree within
+//! their statistical error on `box`, on a small many-light scene (`ring`
+//! with 1,536 lights) and on `few-lights` (environment light). And the
+//! `embed` example runs and passes its own checks.
+//!
+//! The example's modules are compiled in here as they are (`#[path]`), so
+//! the test exercises exactly the code the example runs.
+
+#![allow(dead_code)]
+
+#[path = "../examples/render/bvh.rs"]
+mod bvh;
+#[path = "../examples/render/camera.rs"]
+mod camera;
+#[path = "../examples/embed.rs"]
+mod embed;
+#[path = "../examples/render/geometry.rs"]
+mod geometry;
+#[path = "../examples/render/integrator.rs"]
+mod integrator;
+#[path = "../examples/render/lights.rs"]
+mod lights;
+#[path = "../examples/render/materials.rs"]
+mod materials;
+#[path = "../examples/render/methods.rs"]
+mod methods;
+#[path = "../examples/render/rng.rs"]
+mod rng;
+#[path = "../examples/render/run.rs"]
+mod run;
+#[path = "../examples/render/scene.rs"]
+mod scene;
+#[path = "../examples/render/scenes/mod.rs"]
+mod scenes;
+
+use methods::{GuideParams, Method};
+use run::{Budget, Rendered, Settings};
+
+/// Mean luminance of the whole image and of its four quadrants, with the
+/// standard error of each (from the per-pixel variance estimates).
+fn region_means(r: &Rendered) -> Vec<(f64, f64)> {
+    let (w, h) = (r.width as usize, r.height as usize);
+    let regions = [
+        (0, w, 0, h),
+        (0, w / 2, 0, h / 2),
+        (w / 2, w, 0, h / 2),
+        (0, w / 2, h / 2, h),
+        (w / 2, w, h / 2, h),
+    ];
+    regions
+        .iter()
+        .map(|&(x0, x1, y0, y1)| {
+            let (mut sum, mut var) = (0.0f64, 0.0f64);
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    let i = y * w + x;
+                    sum += f64::from(lights::luminance(r.image[i]));
+                    // Variance of a luminance: the channels' variances with
+                    // squared weights (their covariance ignored, which only
+                    // matters little for a tolerance of several sigma).
+                    let v = r.variance[i];
+                    var += f64::from(
+                        0.2126f32.powi(2) * v.x + 0.7152f32.powi(2) * v.y + 0.0722f32.powi(2) * v.z,
+                    );
+                }
+            }
+            let n = ((x1 - x0) * (y1 - y0)) as f64;
+            (sum / n, var.sqrt() / n)
+        })
+        .collect()
+}
+
+/// Renders `scene` with every method at `spp` and checks that all region
+/// means agree with their inverse-variance weighted average within `k`
+/// standard errors (plus 0.5% for the variance estimates' own noise).
+fn methods_agree(name: &str, width: u32, height: u32, spp: u64) {
+    let scene = scenes::build(name, scenes::Size::Small).expect("known scene");
+    let settings = Settings {
+        width,
+        height,
+        budget: Budget::Spp(spp),
+        params: GuideParams {
+            sigma: 0.01,
+            spatial_threshold: 250.0,
+        },
+        seed: 3,
+        progress: false,
+    };
+    let results: Vec<(Method, Vec<(f64, f64)>)> = Method::ALL
+        .iter()
+        .map(|&m| {
+            let r = run::render(&scene, m, &settings);
+            assert_eq!(r.spp, spp, "{name} {}: spp", m.name());
+            assert!(
+                r.image.iter().all(|p| p.is_finite()),
+                "{name} {}: non-finite pixels",
+                m.name()
+            );
+            (m, region_means(&r))
+        })
+        .collect();
+    let k = 4.5;
+    for region in 0..5 {
+        let (mut num, mut den) = (0.0, 0.0);
+        for (_, rm) in &results {
+            let (m, e) = rm[region];
+            assert!(e > 0.0, "{name}: a method reports no error estimate");
+            num += m / (e * e);
+            den += 1.0 / (e * e);
+        }
+        let pooled = num / den;
+        assert!(pooled > 0.0, "{name}: black image");
+        for (method, rm) in &results {
+            let (m, e) = rm[region];
+            let tolerance = k * e + 0.005 * pooled;
+            assert!(
+                (m - pooled).abs() <= tolerance,
+                "{name} region {region}: {} mean {m:.5} +- {e:.5} vs all methods {pooled:.5} (tolerance {tolerance:.5})",
+                method.name()
+            );
+        }
+    }
+}
+
+#[test]
+fn box_every_method_converges_to_the_same_image() {
+    methods_agree("box", 48, 36, 64);
+}
+
+#[test]
+fn many_lights_every_method_converges_to_the_same_image() {
+    methods_agree("ring", 48, 36, 64);
+}
+
+#[test]
+fn environment_every_method_converges_to_the_same_image() {
+    methods_agree("few-lights", 48, 36, 128);
+}
+
+#[test]
+fn embed_runs_and_its_checks_hold() {
+    assert!(embed::run());
+}
