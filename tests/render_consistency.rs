@@ -142,3 +142,54 @@ fn environment_every_method_converges_to_the_same_image() {
 fn embed_runs_and_its_checks_hold() {
     assert!(embed::run());
 }
+
+/// The guided methods really learn: after a few training iterations their
+/// structures have grown well past the one-cell, uniform start (catches a
+/// method whose training records never arrive, which no mean would show).
+#[test]
+fn guided_methods_train_their_structures() {
+    let scene = scenes::build("box", scenes::Size::Small).expect("known scene");
+    let settings = Settings {
+        width: 48,
+        height: 36,
+        budget: Budget::Spp(64),
+        params: GuideParams {
+            sigma: 0.01,
+            spatial_threshold: 250.0,
+        },
+        seed: 5,
+        progress: false,
+    };
+    let fresh = |m: Method| {
+        let mut s = settings.clone();
+        s.budget = Budget::Spp(1);
+        run::render(&scene, m, &s)
+    };
+    for m in [Method::PtGlt, Method::Ppg, Method::PpgGlt] {
+        let (start, trained) = (fresh(m), run::render(&scene, m, &settings));
+        assert!(
+            trained.iterations >= 5,
+            "{}: {} iterations",
+            m.name(),
+            trained.iterations
+        );
+        if m.uses_glt() || m.uses_field() {
+            assert!(
+                trained.glt_bytes > 4 * start.glt_bytes,
+                "{}: cuts did not grow ({} -> {} bytes)",
+                m.name(),
+                start.glt_bytes,
+                trained.glt_bytes
+            );
+        }
+        if m.uses_sd_tree() || m.uses_field() {
+            assert!(
+                trained.sd_tree_bytes > 4 * start.sd_tree_bytes,
+                "{}: SD-tree did not grow ({} -> {} bytes)",
+                m.name(),
+                start.sd_tree_bytes,
+                trained.sd_tree_bytes
+            );
+        }
+    }
+}

@@ -324,16 +324,16 @@ pub fn radiance(
         origin = offset_origin(p, n, wi);
         dir = wi;
     }
-    if let (true, Some(t)) = (train_sd, guides.sd_tree) {
-        for r in records.iter() {
-            if r.radiance.is_finite() {
-                t.splat(r.pos, r.dir, luminance(r.radiance), r.pdf, s.rng());
-                t.record_fraction(
-                    r.pos,
-                    r.bsdf_pdf,
-                    r.guide_pdf,
-                    luminance(r.weight * r.radiance),
-                );
+    if train_sd {
+        for r in records.iter().filter(|r| r.radiance.is_finite()) {
+            let radiance = luminance(r.radiance);
+            let contribution = luminance(r.weight * r.radiance);
+            if let Some(t) = guides.sd_tree {
+                t.splat(r.pos, r.dir, radiance, r.pdf, s.rng());
+                t.record_fraction(r.pos, r.bsdf_pdf, r.guide_pdf, contribution);
+            } else if let Some(f) = guides.field {
+                f.splat_radiance(r.pos, r.dir, radiance, r.pdf, s.rng());
+                f.record_fraction(r.pos, r.bsdf_pdf, r.guide_pdf, contribution);
             }
         }
     }
