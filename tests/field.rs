@@ -786,7 +786,11 @@ fn memory_report_adds_up_and_compares_cuts_with_quadtrees() {
     assert_eq!(m.cuts.nodes, nodes);
     assert_eq!(m.cuts.node_bytes, 12 * nodes);
     assert_eq!(m.cuts.sum_bytes, 8 * (2 * nodes + m.sd.cells));
-    assert_eq!(m.shared_bytes, 4 * tree.node_count());
+    // Split table 4 B per node; walk table one 16-B pair per inner node + root.
+    assert_eq!(
+        m.shared_bytes,
+        4 * tree.node_count() + 8 * (tree.node_count() + 1)
+    );
     assert_eq!(m.cut_bytes(), m.cuts.node_bytes + m.cuts.sum_bytes);
     assert_eq!(m.quadtree_bytes(), m.sd.quadtree_bytes);
     assert_eq!(m.capped(), m.sd.total() + m.cut_bytes());

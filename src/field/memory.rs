@@ -19,7 +19,8 @@ pub struct FieldMemory {
     /// `sd.spatial_bytes` and are not added again in the totals.
     pub cuts: CutMemory,
     /// The [`GuidingTree`](crate::glt::GuidingTree)'s split table, shared
-    /// by all cells (4 bytes per light-tree node).
+    /// by all cells: split and walk tables, 12 bytes per light-tree node
+    /// (plus 8).
     pub shared_bytes: usize,
 }
 

@@ -86,8 +86,8 @@ pub struct GltMemory {
     /// the inline [`GltCell`] values (which include the cuts' inline parts,
     /// so those are not added twice in [`GltMemory::total`]).
     pub spatial_bytes: usize,
-    /// The [`GuidingTree`]'s split table, shared by all cells (4 bytes per
-    /// light-tree node).
+    /// The [`GuidingTree`]'s split and walk tables, shared by all cells (12
+    /// bytes per light-tree node, plus 8).
     pub shared_bytes: usize,
 }
 

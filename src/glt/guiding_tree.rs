@@ -3,13 +3,15 @@
 
 use super::config::CutConfig;
 use super::cut::GuidingCut;
+use super::walk::WalkTable;
 use crate::light_tree::LightHierarchy;
 use crate::math::Descent;
 use alloc::vec::Vec;
 
 /// The global light tree prepared for guiding: the hierarchy, each inner
-/// node's energy split precomputed (4 bytes per node) and the cut
-/// configuration. One per scene; every cell's [`GuidingCut`] is sampled
+/// node's energy split precomputed (4 bytes per node), the tree re-laid
+/// out for sampling walks (8 bytes per node, see `src/glt/walk.rs`) and the
+/// cut configuration. One per scene; every cell's [`GuidingCut`] is sampled
 /// ([`GuidingTree::sample`]), splatted ([`GuidingTree::splat`]) and refined
 /// ([`GuidingTree::refine`]) through it.
 ///
@@ -27,6 +29,7 @@ use alloc::vec::Vec;
 pub struct GuidingTree<'a, H: LightHierarchy + ?Sized> {
     tree: &'a H,
     split: Vec<f32>,
+    walk: WalkTable,
     config: CutConfig,
     has_energy: bool,
 }
@@ -71,15 +74,17 @@ impl<'a, H: LightHierarchy + ?Sized> GuidingTree<'a, H> {
     /// Prepares `tree` for guiding with `config` (sanitized, see
     /// [`CutConfig::sanitized`]). O(nodes).
     pub fn new(tree: &'a H, config: CutConfig) -> Self {
-        let split = (0..tree.node_count() as u32)
+        let split: Vec<f32> = (0..tree.node_count() as u32)
             .map(|n| match tree.children(n) {
                 Some([l, r]) => encode_split(tree.energy(l), tree.energy(r)),
                 None => f32::NAN,
             })
             .collect();
+        let walk = WalkTable::new(tree, |n| split.get(n as usize).copied().unwrap_or(f32::NAN));
         Self {
             tree,
             split,
+            walk,
             config: config.sanitized(),
             has_energy: tree.root().is_some_and(|r| tree.energy(r) > 0.0),
         }
@@ -103,9 +108,23 @@ impl<'a, H: LightHierarchy + ?Sized> GuidingTree<'a, H> {
         self.has_energy
     }
 
-    /// Heap bytes of the split table (4 per light-tree node).
+    /// Heap bytes of the split table and the walk table (12 per
+    /// light-tree node).
     pub fn bytes(&self) -> usize {
-        self.split.len() * core::mem::size_of::<f32>()
+        self.split.len() * core::mem::size_of::<f32>() + self.walk.bytes()
+    }
+
+    /// The raw split-table entry of `node` (NaN for leaves and indices out
+    /// of range); [`decode_split`] turns it into probabilities.
+    #[inline(always)]
+    pub(crate) fn raw_split(&self, node: u32) -> f32 {
+        self.split.get(node as usize).copied().unwrap_or(f32::NAN)
+    }
+
+    /// The light tree laid out for sampling walks.
+    #[inline(always)]
+    pub(crate) fn walk(&self) -> &WalkTable {
+        &self.walk
     }
 
     /// The prior (energy) probabilities of the children of inner node
@@ -115,13 +134,6 @@ impl<'a, H: LightHierarchy + ?Sized> GuidingTree<'a, H> {
     #[inline(always)]
     pub fn prior_split(&self, node: u32) -> Option<(f64, f64)> {
         decode_split(*self.split.get(node as usize)?)
-    }
-
-    /// The raw split-table entry of `node` (NaN for leaves and indices out
-    /// of range); [`decode_split`] turns it into probabilities.
-    #[inline(always)]
-    pub(crate) fn raw_split(&self, node: u32) -> f32 {
-        self.split.get(node as usize).copied().unwrap_or(f32::NAN)
     }
 
     /// The initial cut of a cell: the light tree's root split by energy,

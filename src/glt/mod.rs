@@ -12,6 +12,8 @@
 //! - `cut_node.rs`: the 12-byte [`CutNode`] and its [`Slot`]s;
 //! - `sampling.rs`: **the GLT's sampling rule** and its pmf (cut, then the
 //!   light tree, mixed with the energy prior and the environment light);
+//! - `walk.rs`: the light tree re-laid out for the sampling walk (both
+//!   children of a node in one 16-byte load);
 //! - `splat.rs`: recording direct-light estimates ([`GuidingTree::splat`]);
 //! - `refine.rs`: rebuilding the cut from its sums ([`GuidingTree::refine`]);
 //! - `config.rs`: [`CutConfig`], [`BelowCut`], [`SplitPrior`];
@@ -34,6 +36,7 @@ mod guiding_tree;
 mod refine;
 mod sampling;
 mod splat;
+mod walk;
 
 pub use config::{BelowCut, CutConfig, SplitPrior};
 pub use cut::{CutError, CutMemory, GuidingCut};

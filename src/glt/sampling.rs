@@ -28,6 +28,7 @@ use super::config::{BelowCut, CutConfig};
 use super::cut::GuidingCut;
 use super::cut_node::CutNode;
 use super::guiding_tree::{GuidingTree, decode_split};
+use super::walk::WalkNode;
 use crate::emitter::ShadingContext;
 use crate::light_sampler::{LightId, LightSample, LightSampler};
 use crate::light_tree::LightHierarchy;
@@ -86,12 +87,14 @@ impl Mixture {
     }
 }
 
-/// Where a walk is: an inner light-tree node and, while inside the cut, the
-/// cut node that stands for it.
+/// Where a walk is: a light-tree node's walk-table entry, the node itself
+/// (tracked only for [`BelowCut::Importance`], which reads its bounds) and,
+/// while inside the cut, the cut node that stands for it.
 #[derive(Clone, Copy, Debug)]
 struct Cursor {
+    node: WalkNode,
     light: u32,
-    cut: Option<u32>,
+    cut: Option<CutNode>,
 }
 
 /// The probabilities at one inner light-tree node.
@@ -161,9 +164,29 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
     #[inline(always)]
     fn root(&self) -> Option<Cursor> {
         Some(Cursor {
+            node: self.guide.walk().root()?,
             light: self.tree.root()?,
-            cut: (!self.nodes.is_empty()).then_some(0),
+            cut: self.nodes.first().copied(),
         })
+    }
+
+    /// The cut nodes on both sides below a step (`None` where the cut
+    /// ends), read before the walk chooses a side so the next level's load
+    /// overlaps with this one's arithmetic.
+    #[inline(always)]
+    fn cut_children(&self, step: &Step) -> [Option<CutNode>; 2] {
+        step.next
+            .map(|c| c.and_then(|i| self.nodes.get(i as usize).copied()))
+    }
+
+    /// The light-tree node of child `side` of `light`, when the rule below
+    /// the cut needs it (else a placeholder: only importance reads it).
+    #[inline(always)]
+    fn child_light(&self, light: u32, side: usize) -> u32 {
+        match self.below {
+            BelowCut::Energy => 0,
+            BelowCut::Importance => self.tree.children(light).map_or(u32::MAX, |c| c[side]),
+        }
     }
 
     /// The importance probabilities of the children of inner node `node`.
@@ -175,10 +198,10 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
     }
 
     /// The probabilities of both components at the inner node `at`, whose
-    /// entry in the guiding tree's split table is `split`.
+    /// split-table entry is `split`.
     #[inline(always)]
     fn step(&self, at: Cursor, split: f32) -> Step {
-        match at.cut.and_then(|i| self.nodes.get(i as usize)) {
+        match at.cut {
             Some(node) => Step {
                 cut: Some(node.probabilities()),
                 prior: if self.prior {
@@ -243,27 +266,27 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
             cut: 1.0,
             prior: 1.0,
         };
-        let mut children = self.tree.children(at.light);
-        let mut split = self.guide.raw_split(at.light);
-        while let Some([l, r]) = children {
+        let walk = self.guide.walk();
+        let mut children = at.node.children().map(|k| walk.pair(k));
+        while let Some(pair) = children {
             // Load the next level for both sides before choosing: these
             // loads do not depend on `u`, so they overlap with this level's
             // choice instead of waiting for it (the walk is latency-bound).
-            let grand = [self.tree.children(l), self.tree.children(r)];
-            let splits = [self.guide.raw_split(l), self.guide.raw_split(r)];
-            let step = self.step(at, split);
+            let grand = walk.grandchildren(pair);
+            let step = self.step(at, at.node.split);
+            let cuts = self.cut_children(&step);
             let (pl, pr) = if use_cut { step.cut } else { step.prior }?;
             let side = d.choose_with(pl, pr);
             self.apply(&mut p, &step, side);
             let k = side.index();
             at = Cursor {
-                light: [l, r][k],
-                cut: step.next[k],
+                node: pair.0[k],
+                light: self.child_light(at.light, k),
+                cut: cuts[k],
             };
-            children = grand[k];
-            split = splits[k];
+            children = at.node.children().map(|_| grand[k]);
         }
-        let emitter = self.tree.emitter(at.light)?;
+        let emitter = at.node.emitter()?;
         Some((LightId::Emitter(emitter), m.emitter_pmf(p)))
     }
 
@@ -283,6 +306,9 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
             cut: 1.0,
             prior: 1.0,
         };
+        // The path names every node, so the split loads are independent of
+        // each other (unlike the walk table's chain, which `sample` follows
+        // because it does not know the path in advance).
         for &(node, side) in path.steps() {
             at.light = node;
             let step = self.step(at, self.guide.raw_split(node));
@@ -290,7 +316,7 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
             if p.cut == 0.0 && (!self.prior || p.prior == 0.0) {
                 return 0.0;
             }
-            at.cut = step.next[side.index()];
+            at.cut = step.next[side.index()].and_then(|i| self.nodes.get(i as usize).copied());
         }
         self.mixture.emitter_pmf(p)
     }
