@@ -189,6 +189,24 @@ fn weights_are_inverse_variance_and_sum_to_one() {
 }
 
 #[test]
+fn combined_variance_is_the_inverse_sum_of_inverse_variances() {
+    let mut c = InverseVarianceCombiner::new();
+    assert_eq!(c.combined_variance(), None);
+    c.push_image(&[1.0; 4], Some(4.0), 8);
+    c.push_image(&[1.0; 4], Some(1.0), 16);
+    c.push_image(&[1.0; 4], Some(0.25), 32);
+    let expected = 1.0 / (1.0 / 4.0 + 1.0 + 4.0);
+    assert!((c.combined_variance().unwrap() - expected).abs() < 1e-15);
+    // An iteration without an estimate gets weight 0 and is ignored ...
+    c.push_image(&[1.0; 4], None, 1);
+    assert!((c.combined_variance().unwrap() - expected).abs() < 1e-15);
+    // ... but with no estimate anywhere the variance is unknown.
+    let mut d = InverseVarianceCombiner::new();
+    d.push_image(&[1.0; 4], None, 4);
+    assert_eq!(d.combined_variance(), None);
+}
+
+#[test]
 fn combining_the_last_iterations_beats_the_last_alone() {
     // Iteration k renders 2^k passes with per-pass variance shrinking as
     // guiding improves; the true pixel value is 2 everywhere.
@@ -196,6 +214,7 @@ fn combining_the_last_iterations_beats_the_last_alone() {
     let pixels = 400;
     let trials = 30;
     let (mut err_combined, mut err_last, mut bias) = (0.0, 0.0, 0.0);
+    let mut predicted = 0.0;
     for _ in 0..trials {
         let mut c = InverseVarianceCombiner::new();
         let mut last = Vec::new();
@@ -213,6 +232,8 @@ fn combining_the_last_iterations_beats_the_last_alone() {
         }
         let w = c.weights();
         assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+        let v = c.combined_variance().unwrap();
+        predicted += v;
         assert!(w.iter().all(|&w| w > 0.0));
         let img = c.combine();
         for (a, b) in img.iter().zip(&last) {
@@ -225,6 +246,13 @@ fn combining_the_last_iterations_beats_the_last_alone() {
     assert!(
         err_combined < 0.9 * err_last,
         "{err_combined} vs {err_last}"
+    );
+    // The combiner's own variance estimate predicts the measured error.
+    let measured = err_combined / n;
+    let predicted = predicted / trials as f64;
+    assert!(
+        (predicted / measured - 1.0).abs() < 0.15,
+        "predicted {predicted} measured {measured}"
     );
     // Unbiased: the mean error is within a few standard errors of 0.
     let se = (err_combined / n).sqrt() / n.sqrt();

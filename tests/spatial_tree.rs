@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 use guiding::math::Aabb;
-use guiding::spatial::{BinaryTree, CellId, SpatialError, SpatialTree};
+use guiding::spatial::{BinaryTree, CellId, SpatialError, SpatialFilter, SpatialTree};
 
 fn unit() -> Aabb {
     Aabb::new(Vec3::ZERO, Vec3::ONE)
@@ -351,4 +351,77 @@ fn map_keeps_topology() {
     }
     let owned = t.map(|w| w + 1);
     assert!(owned.data_slice().iter().all(|w| *w == 4));
+}
+
+/// The stochastic box skips the second lookup when the jittered point stays
+/// in its cell; it must pick exactly the cell a lookup of that point picks,
+/// on split planes, root faces and deep cells included.
+#[test]
+fn stochastic_box_picks_the_cell_a_lookup_of_the_jittered_point_picks() {
+    let scene = Aabb::new(Vec3::splat(-1.0), Vec3::splat(3.0));
+    let mut t = BinaryTree::new(scene, 0.0f64).unwrap();
+    t.refine(|_, depth| depth < 4, |w| *w, None);
+    // Uneven refinement: two more levels per pass around one point (as in
+    // `deeper_than_64_levels_at_a_point_cluster`), 30 passes.
+    let corner = Vec3::new(-0.7, 2.2, 0.3);
+    for _ in 0..30 {
+        for w in t.data_slice_mut() {
+            *w = 0.0;
+        }
+        let c = t.locate(corner).unwrap();
+        *t.data_mut(c) = 20.0;
+        t.refine(
+            |w, _| *w > 8.0,
+            |w| {
+                *w *= 0.5;
+                *w
+            },
+            None,
+        );
+    }
+    assert!(t.max_depth() > 60, "{}", t.max_depth());
+    let root = t.root_bounds();
+    let mut checked = 0;
+    let mut stayed = 0;
+    let ps = points(3000, 9);
+    let js = points(3000, 10);
+    for (i, (u, j)) in ps.iter().zip(&js).enumerate() {
+        let mut p = root.min + *u * root.diagonal();
+        let (cell, b) = t.locate_with_bounds(p).unwrap();
+        // Every third point sits on a face of its cell (split planes and
+        // the root's faces).
+        match i % 3 {
+            1 => p.x = b.min.x,
+            2 => p.y = b.max.y,
+            _ => {}
+        }
+        let mut jitter = *j - 0.5;
+        if i % 7 == 0 {
+            jitter = Vec3::new(0.5 - f32::EPSILON, -0.5, 0.0);
+        }
+        if i % 5 == 0 {
+            // Exactly onto the cell's upper corner (dyadic cells: exact), which
+            // belongs to the neighbours unless it is the root's.
+            p = b.max - 0.25 * b.diagonal();
+            jitter = Vec3::splat(0.25);
+        }
+        let (cell, b) = t.locate_with_bounds(p).unwrap_or((cell, b));
+        let q = root.clamp(p) + jitter * b.diagonal();
+        let mut got = None;
+        t.spread(
+            p,
+            SpatialFilter::StochasticBox,
+            || jitter,
+            |c, w| {
+                assert_eq!(w, 1.0);
+                got = Some(c);
+            },
+        );
+        assert_eq!(got, t.locate(q), "point {p}, jitter {jitter}");
+        stayed += (got == Some(cell)) as usize;
+        checked += 1;
+    }
+    assert_eq!(checked, 3000);
+    // Both branches ran.
+    assert!(stayed > 300 && stayed < 2700, "{stayed}");
 }

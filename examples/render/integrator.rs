@@ -33,9 +33,14 @@ pub struct Guides<'a> {
     pub train: bool,
 }
 
+/// The field's cell at a path vertex (`ppg-glt`): found once, it serves
+/// the vertex's queries and every record made there later.
+type Located<'a> = FieldVertex<'a, 'a, LightTree>;
+
 /// One guided path vertex awaiting its SD-tree splat.
 #[derive(Clone, Copy, Debug)]
-pub struct Record {
+pub struct Record<'a> {
+    at: Option<Located<'a>>,
     pos: Vec3,
     dir: Vec3,
     pdf: f32,
@@ -48,7 +53,8 @@ pub struct Record {
 
 /// The last scattering vertex, for MIS at the next emitter hit.
 #[derive(Clone, Copy)]
-struct Vertex {
+struct Vertex<'a> {
+    at: Option<Located<'a>>,
     pos: Vec3,
     normal: Vec3,
     pdf_dir: f32,
@@ -91,14 +97,16 @@ impl DirGuide<'_> {
     }
 }
 
-/// Records a direct-light estimate for `light` seen from `p` (the GLT's
-/// splat), into the GLT or the field.
+/// Records a direct-light estimate for `light` seen from `v` (the GLT's
+/// splat), into the GLT or the field (through the vertex's located cell).
 #[inline]
-fn splat_light(guides: &Guides, p: Vec3, light: LightId, value: f32, s: &mut Sampler) {
+fn splat_light(guides: &Guides, v: &Vertex, light: LightId, value: f32, s: &mut Sampler) {
     if let Some(glt) = guides.glt {
-        glt.splat(p, light, value, s.rng());
+        glt.splat(v.pos, light, value, s.rng());
+    } else if let Some(at) = &v.at {
+        at.splat_light(light, value, s.rng());
     } else if let Some(field) = guides.field {
-        field.splat_light(p, light, value, s.rng());
+        field.splat_light(v.pos, light, value, s.rng());
     }
 }
 
@@ -125,7 +133,7 @@ fn safe_div(c: Vec3, d: Vec3) -> Vec3 {
 /// Adds a contribution to the pixel and to the incident radiance of every
 /// recorded vertex before it.
 #[inline]
-fn contribute(l: &mut Vec3, records: &mut [Record], c: Vec3) {
+fn contribute(l: &mut Vec3, records: &mut [Record<'_>], c: Vec3) {
     *l += c;
     for r in records.iter_mut() {
         r.radiance += safe_div(c, r.beta_after);
@@ -134,13 +142,13 @@ fn contribute(l: &mut Vec3, records: &mut [Record], c: Vec3) {
 
 /// The radiance arriving at the camera along `origin + t dir`.
 /// `records` is scratch space reused between paths.
-pub fn radiance(
+pub fn radiance<'a>(
     scene: &Scene,
-    guides: &Guides,
+    guides: &Guides<'a>,
     mut origin: Vec3,
     mut dir: Vec3,
     s: &mut Sampler,
-    records: &mut Vec<Record>,
+    records: &mut Vec<Record<'a>>,
 ) -> Vec3 {
     let max_depth = scene.effects.max_depth;
     let train_light = guides.train && (guides.glt.is_some() || guides.field.is_some());
@@ -170,7 +178,7 @@ pub fn radiance(
                 {
                     let value = luminance(env.radiance) * w / pdf_dir;
                     if value > 0.0 {
-                        splat_light(guides, v.pos, LightId::Environment, value, s);
+                        splat_light(guides, &v, LightId::Environment, value, s);
                     }
                 }
             }
@@ -202,7 +210,7 @@ pub fn radiance(
                 {
                     let value = luminance(le) * w / pdf_dir;
                     if value > 0.0 {
-                        splat_light(guides, v.pos, id, value, s);
+                        splat_light(guides, &v, id, value, s);
                     }
                 }
             }
@@ -218,6 +226,7 @@ pub fn radiance(
             };
             beta *= bs.weight;
             prev = Some(Vertex {
+                at: None,
                 pos: p,
                 normal: ng,
                 pdf_dir: 0.0,
@@ -231,6 +240,13 @@ pub fn radiance(
         let n = if ng.dot(wo) < 0.0 { -ng } else { ng };
         let ctx = ShadingContext::on_surface(p, n);
         let field_vertex = guides.field.and_then(|f| f.vertex(p));
+        let here = Vertex {
+            at: field_vertex,
+            pos: p,
+            normal: n,
+            pdf_dir: 0.0,
+            delta: false,
+        };
         let cell = match (field_vertex, guides.sd_tree) {
             (Some(v), _) => Some(DirGuide::Field(v)),
             (None, Some(t)) => t.cell_at(p).map(DirGuide::Sd),
@@ -274,7 +290,7 @@ pub fn radiance(
                             contribute(&mut l, records, c);
                             if train_light {
                                 let value = luminance(lp.radiance) * w / p_light;
-                                splat_light(guides, p, ls.light, value, s);
+                                splat_light(guides, &here, ls.light, value, s);
                             }
                         }
                     }
@@ -305,6 +321,7 @@ pub fn radiance(
         beta *= weight;
         if train_sd {
             records.push(Record {
+                at: field_vertex,
                 pos: p,
                 dir: wi,
                 pdf,
@@ -316,10 +333,8 @@ pub fn radiance(
             });
         }
         prev = Some(Vertex {
-            pos: p,
-            normal: n,
             pdf_dir: pdf,
-            delta: false,
+            ..here
         });
         origin = offset_origin(p, n, wi);
         dir = wi;
@@ -331,9 +346,10 @@ pub fn radiance(
             if let Some(t) = guides.sd_tree {
                 t.splat(r.pos, r.dir, radiance, r.pdf, s.rng());
                 t.record_fraction(r.pos, r.bsdf_pdf, r.guide_pdf, contribution);
-            } else if let Some(f) = guides.field {
-                f.splat_radiance(r.pos, r.dir, radiance, r.pdf, s.rng());
-                f.record_fraction(r.pos, r.bsdf_pdf, r.guide_pdf, contribution);
+            } else if let Some(v) = &r.at {
+                // The field: no second lookup, the vertex kept its cell.
+                v.splat_radiance(r.dir, radiance, r.pdf, s.rng());
+                v.record_fraction(r.bsdf_pdf, r.guide_pdf, contribution);
             }
         }
     }

@@ -111,6 +111,25 @@ impl InverseVarianceCombiner {
         raw.iter().map(|w| w / total).collect()
     }
 
+    /// The estimated variance of the combined image (averaged over
+    /// elements, like each iteration's): `sum w_i^2 v_i` over the held
+    /// iterations, which for inverse-variance weights is
+    /// `1 / sum (1 / v_i)`, below every single iteration's. `None` when an
+    /// iteration with positive weight has no estimate (or nothing was
+    /// pushed).
+    pub fn combined_variance(&self) -> Option<f64> {
+        if self.entries.is_empty() {
+            return None;
+        }
+        let mut total = 0.0f64;
+        for (e, w) in self.entries.iter().zip(self.weights()) {
+            if w > 0.0 {
+                total += w * w * e.variance?;
+            }
+        }
+        Some(total)
+    }
+
     /// The combined image (as long as the shortest held image).
     pub fn combine(&self) -> Vec<f32> {
         let len = self

@@ -55,6 +55,12 @@ pub fn next_iteration(index: u32, remaining_passes: u64) -> Option<Iteration> {
 /// With no usable measurement (`seconds_per_pass` not positive and finite,
 /// e.g. before the first pass) it plans `2^index` passes, not last. `None`
 /// when the time left does not pay for one pass.
+///
+/// The measurement comes from a training iteration, which also splats
+/// records; the last iteration only renders and is usually cheaper per
+/// pass, so it affords more passes than planned here. A renderer with a
+/// hard deadline should render the last iteration until the time is up
+/// (as the `render` example does) rather than a fixed pass count.
 pub fn next_iteration_by_time(
     index: u32,
     remaining_seconds: f64,

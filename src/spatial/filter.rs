@@ -74,8 +74,18 @@ impl<T> BinaryTree<T> {
             SpatialFilter::Nearest => visit(cell, 1.0),
             SpatialFilter::StochasticBox => {
                 let q = self.root.clamp(p) + jitter() * bounds.diagonal();
+                // About 42% of jittered points stay in their cell ((3/4)^3
+                // for a point uniform in it): the cell's half-open bounds
+                // are exactly what the lookup would compare against, so
+                // skip it then.
+                let home = q.cmpge(bounds.min).all() && q.cmplt(bounds.max).all();
                 // `q` is finite: a finite point plus at most a cell's size.
-                visit(self.locate(q).unwrap_or(cell), 1.0);
+                let at = if home {
+                    cell
+                } else {
+                    self.locate(q).unwrap_or(cell)
+                };
+                visit(at, 1.0);
             }
             SpatialFilter::Box => self.spread_box(p, &bounds, visit),
         }
