@@ -225,8 +225,9 @@ fn config_strategy() -> impl Strategy<Value = CutConfig> {
             Just(Some(1.0))
         ],
         any::<bool>(),
+        prop_oneof![Just(0u32), Just(1), Just(64)],
     )
-        .prop_map(|(sigma, alpha, variant, environment, exact)| {
+        .prop_map(|(sigma, alpha, variant, environment, exact, min_splats)| {
             let (below_cut, split_prior) = ALL_CONFIGS[variant];
             CutConfig {
                 sigma,
@@ -239,6 +240,7 @@ fn config_strategy() -> impl Strategy<Value = CutConfig> {
                 } else {
                     Accumulation::Fast
                 },
+                min_splats,
             }
         })
 }
@@ -397,6 +399,8 @@ fn energy_split_prior_preserves_the_distribution() {
             alpha: 0.0,
             split_prior: prior,
             sigma: 0.002,
+            // The paper's rule: rebuild from any data (here two splats).
+            min_splats: 0,
             ..CutConfig::default()
         };
         let guide = GuidingTree::new(&tree, config);
@@ -430,6 +434,62 @@ fn energy_split_prior_preserves_the_distribution() {
     }
 }
 
+/// Below `min_splats` non-zero splats a refine changes nothing and the
+/// sums carry over; the rebuild that follows sees every iteration's data.
+#[test]
+fn too_few_splats_defer_the_rebuild_and_keep_the_data() {
+    let mut rng = Rand::new(8);
+    let lights = lights_in_box(&mut rng, 300, 5.0);
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let guide = GuidingTree::new(&tree, CutConfig::default());
+    let min = guide.config().min_splats;
+    assert!(min > 1);
+    let mut cut = guide.new_cut();
+    let ctx = ShadingContext::at(Vec3::ZERO);
+    let pmfs = |cut: &GuidingCut| -> Vec<f64> {
+        (0..300)
+            .map(|e| guide.pmf_exact(cut, &ctx, LightId::Emitter(e)))
+            .collect()
+    };
+    let before = pmfs(&cut);
+    // Zeros (occluded samples) are not data.
+    for e in 0..300 {
+        assert_eq!(
+            guide.splat(&cut, LightId::Emitter(e), 0.0),
+            SplatOutcome::Zero
+        );
+    }
+    assert!(!guide.refine(&mut cut));
+    // Half the floor on emitter 17, then the other half on emitter 42:
+    // the first refine keeps everything, the second rebuilds from both.
+    for _ in 0..min / 2 {
+        guide.splat(&cut, LightId::Emitter(17), 1.0);
+    }
+    assert!(!guide.refine(&mut cut));
+    assert_eq!(pmfs(&cut), before);
+    for _ in 0..min - min / 2 {
+        guide.splat(&cut, LightId::Emitter(42), 1.0);
+    }
+    assert!(guide.refine(&mut cut));
+    assert_valid_cut(&tree, &cut);
+    let after = pmfs(&cut);
+    // Exactly the cut that all of it in one iteration gives.
+    let mut once = guide.new_cut();
+    for _ in 0..min / 2 {
+        guide.splat(&once, LightId::Emitter(17), 1.0);
+    }
+    for _ in 0..min - min / 2 {
+        guide.splat(&once, LightId::Emitter(42), 1.0);
+    }
+    assert!(guide.refine(&mut once));
+    assert_eq!(once.nodes(), cut.nodes());
+    assert_eq!(pmfs(&once), after);
+    assert_ne!(after, before);
+    // The sums were spent: a refine right after keeps the cut.
+    assert!(!guide.refine(&mut cut));
+    assert_eq!(pmfs(&cut), after);
+}
+
 /// Splitting goes down to single emitters; a concentrated stream then
 /// merges everything else back into few clusters.
 #[test]
@@ -437,7 +497,12 @@ fn splits_to_leaves_and_merges_back() {
     let mut rng = Rand::new(5);
     let lights = lights_in_box(&mut rng, 300, 5.0);
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
-    let config = CutConfig::default();
+    // The paper's rule: rebuild from any data (the second phase has ten
+    // splats per pass).
+    let config = CutConfig {
+        min_splats: 0,
+        ..CutConfig::default()
+    };
     let guide = GuidingTree::new(&tree, config);
     let mut cut = guide.new_cut();
     // Uniform contributions: every emitter's share 1/300 < sigma, so the cut
@@ -890,7 +955,12 @@ fn prior_floor_survives_extreme_ratios() {
         Emitter::point(Vec3::Y, 1.0),
     ];
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
-    let guide = GuidingTree::new(&tree, CutConfig::default());
+    // The paper's rule: rebuild from any data (one splat per pass).
+    let config = CutConfig {
+        min_splats: 0,
+        ..CutConfig::default()
+    };
+    let guide = GuidingTree::new(&tree, config);
     let alpha = guide.config().alpha;
     let mut cut = guide.new_cut();
     for _ in 0..3 {

@@ -34,6 +34,7 @@ mod scene;
 #[path = "../examples/render/scenes/mod.rs"]
 mod scenes;
 
+use guiding::glt::BelowCut;
 use methods::{GuideParams, Method};
 use run::{Budget, Rendered, Settings};
 
@@ -83,6 +84,9 @@ fn methods_agree(name: &str, width: u32, height: u32, spp: u64) {
         params: GuideParams {
             sigma: 0.01,
             spatial_threshold: 250.0,
+            glt_spatial_threshold: 250.0,
+            below_cut: BelowCut::Energy,
+            min_splats: 64,
         },
         seed: 3,
         progress: false,
@@ -156,6 +160,9 @@ fn guided_methods_train_their_structures() {
         params: GuideParams {
             sigma: 0.01,
             spatial_threshold: 250.0,
+            glt_spatial_threshold: 250.0,
+            below_cut: BelowCut::Energy,
+            min_splats: 64,
         },
         seed: 5,
         progress: false,

@@ -1,6 +1,7 @@
 //! The command line.
 
 use clap::Parser;
+use guiding::glt::BelowCut;
 use std::path::PathBuf;
 
 /// Renders the paper's scene analogues with every light-sampling and
@@ -42,14 +43,28 @@ pub struct Args {
     /// The GLT's split threshold sigma.
     #[arg(long, default_value_t = 0.01)]
     pub sigma: f64,
+    /// How the GLT chooses below its cut: `energy` (the paper) or
+    /// `importance` (Estevez-Kulla importance of the light tree's nodes).
+    #[arg(long, default_value = "energy", value_parser = parse_below_cut)]
+    pub below_cut: BelowCut,
+    /// The fewest non-zero light splats a cut rebuilds from
+    /// (`guiding::glt::CutConfig::min_splats`; 0 = the paper's rule).
+    #[arg(long, default_value_t = guiding::glt::CutConfig::default().min_splats)]
+    pub min_splats: u32,
     /// Worker threads [default: all cores].
     #[arg(long)]
     pub threads: Option<usize>,
-    /// PPG's spatial split threshold c for the SD-tree and the GLT's spatial
-    /// tree [default: 4000 scaled by the pixel count relative to 1280x720,
-    /// at least 250].
-    #[arg(long)]
-    pub spatial_threshold: Option<f64>,
+    /// PPG's spatial split threshold c (radiance records per cell) for the
+    /// SD-tree of `ppg` and the combined field of `ppg-glt`. The default is
+    /// Müller's improved PPG's, not rescaled for the resolution: at
+    /// 256x192 a rescaled 250 doubled `ppg-glt`'s error on `ring` and took
+    /// 15x the memory (docs/results.md, "Spatial thresholds").
+    #[arg(long, default_value_t = 4000.0)]
+    pub spatial_threshold: f64,
+    /// The same threshold for the GLT's own spatial tree (`pt-glt`), which
+    /// counts light splats: finer cells pay off there.
+    #[arg(long, default_value_t = 250.0)]
+    pub glt_spatial_threshold: f64,
     /// Method that renders references.
     #[arg(long, default_value = "ppg-glt")]
     pub reference_method: String,
@@ -76,12 +91,11 @@ pub struct Args {
     pub quiet: bool,
 }
 
-impl Args {
-    /// PPG's spatial threshold for this resolution.
-    pub fn spatial_threshold(&self) -> f64 {
-        self.spatial_threshold.unwrap_or_else(|| {
-            let pixels = f64::from(self.width) * f64::from(self.height);
-            (4000.0 * pixels / (1280.0 * 720.0)).max(250.0)
-        })
+/// Parses `--below-cut`.
+fn parse_below_cut(s: &str) -> Result<BelowCut, String> {
+    match s {
+        "energy" => Ok(BelowCut::Energy),
+        "importance" => Ok(BelowCut::Importance),
+        _ => Err(format!("`{s}`: expected `energy` or `importance`")),
     }
 }

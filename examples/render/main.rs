@@ -113,7 +113,10 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
         budget,
         params: GuideParams {
             sigma: args.sigma,
-            spatial_threshold: args.spatial_threshold(),
+            spatial_threshold: args.spatial_threshold,
+            glt_spatial_threshold: args.glt_spatial_threshold,
+            below_cut: args.below_cut,
+            min_splats: args.min_splats,
         },
         seed: args.seed,
         progress: !args.quiet,

@@ -4,7 +4,7 @@
 
 use crate::scene::Scene;
 use guiding::field::{FieldConfig, GuidingField};
-use guiding::glt::{CutConfig, Glt, GltConfig};
+use guiding::glt::{BelowCut, CutConfig, Glt, GltConfig};
 use guiding::light_sampler::{
     ImportanceTreeSampler, PowerSampler, UniformSampler, WithEnvironment,
 };
@@ -90,9 +90,15 @@ impl Method {
 pub struct GuideParams {
     /// The GLT's split threshold sigma.
     pub sigma: f64,
-    /// PPG's spatial split threshold `c`, for the SD-tree and the GLT's
-    /// spatial tree.
+    /// PPG's spatial split threshold `c` (radiance records), for the
+    /// SD-tree and the combined field.
     pub spatial_threshold: f64,
+    /// The spatial split threshold of the GLT's own tree (light splats).
+    pub glt_spatial_threshold: f64,
+    /// The GLT's rule below its cut.
+    pub below_cut: BelowCut,
+    /// The fewest non-zero light splats a cut rebuilds from.
+    pub min_splats: u32,
 }
 
 /// A fixed (untrained) light sampler for `method`, with the scene's
@@ -123,6 +129,8 @@ pub fn fixed_sampler<'a>(
 fn cut_config(scene: &Scene, params: &GuideParams) -> CutConfig {
     CutConfig {
         sigma: params.sigma,
+        below_cut: params.below_cut,
+        min_splats: params.min_splats,
         environment: scene
             .environment
             .map(|_| f64::from(scene.environment_probability)),
@@ -171,7 +179,7 @@ pub fn new_glt<'a>(
     }
     let config = GltConfig {
         cut: cut_config(scene, params),
-        spatial_threshold: params.spatial_threshold,
+        spatial_threshold: params.glt_spatial_threshold,
         spatial_budget: None,
     };
     Some(Glt::new(&scene.light_tree, scene.bounds, config).expect("scene bounds are finite"))

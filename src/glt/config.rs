@@ -91,6 +91,17 @@ pub struct CutConfig {
     /// [`Accumulation::Deterministic`] gives bit-identical learned cuts
     /// whatever the thread count (48 bytes per sum instead of 8).
     pub accumulation: Accumulation,
+    /// The fewest non-zero splats a cut rebuilds from. Below it,
+    /// [`GuidingTree::refine`](super::GuidingTree::refine) keeps the cut as
+    /// it is and lets its sums go on accumulating into the next iteration:
+    /// a light splat is an unbiased estimate whatever distribution drew it,
+    /// so sums from several iterations add up. Without this floor a cell
+    /// that drew a handful of splats (cells of the combined field split on
+    /// radiance records, not light splats) rebuilds its cut around those
+    /// few lights, and only `alpha` stands between it and the rest.
+    /// `0` gives the paper's rule (rebuild from any data). Default 64,
+    /// measured (docs/results.md, "The cut's data floor").
+    pub min_splats: u32,
 }
 
 impl Default for CutConfig {
@@ -102,6 +113,7 @@ impl Default for CutConfig {
             split_prior: SplitPrior::Half,
             environment: None,
             accumulation: Accumulation::Fast,
+            min_splats: 64,
         }
     }
 }

@@ -4,7 +4,7 @@
 use super::config::CutConfig;
 use super::cut_node::{CutNode, Slot};
 use crate::light_tree::LightHierarchy;
-use crate::math::{Side, SumBuffer};
+use crate::math::{Counter, Side, SumBuffer};
 use alloc::vec;
 use alloc::vec::Vec;
 
@@ -31,6 +31,9 @@ pub struct GuidingCut {
     /// Learned probability of the environment light among everything the
     /// cell collected (before the mixture with the prior).
     pub(super) env_fraction: f32,
+    /// Non-zero splats recorded since the last rebuild (see
+    /// [`CutConfig::min_splats`]).
+    pub(super) recorded: Counter,
 }
 
 /// Why [`GuidingCut::check`] rejected a cut.
@@ -121,6 +124,7 @@ impl GuidingCut {
             nodes,
             sums,
             env_fraction: config.environment.unwrap_or(0.0) as f32,
+            recorded: Counter::new(),
         }
     }
 

@@ -26,7 +26,10 @@ struct Task {
 impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
     /// Rebuilds `cut`'s sampled copy from the accumulated sums, then zeroes them
     /// (swapping the two copies). Returns false when the cell collected
-    /// nothing from emitters: then the cut is kept as it was.
+    /// nothing from emitters: then the cut is kept as it was. A cut that
+    /// recorded fewer than [`CutConfig::min_splats`](super::CutConfig::min_splats)
+    /// non-zero splats since its last rebuild is left entirely alone, sums
+    /// included, to go on accumulating (also false).
     ///
     /// Top-down from the root with the cell's total `T`: a slot whose weight
     /// is above `sigma * T` and whose light node is not a leaf becomes a cut
@@ -39,6 +42,11 @@ impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
     /// `f32`). The environment fraction becomes `env / (env + T)`.
     pub fn refine(&self, cut: &mut GuidingCut) -> bool {
         let config = self.config();
+        if cut.recorded.get() < u64::from(config.min_splats) {
+            // Too little data: keep the cut, keep accumulating.
+            return false;
+        }
+        cut.recorded.reset();
         let n = cut.nodes.len();
         let clusters = sum_count(n) - 1;
         let sums: Vec<f64> = (0..clusters).map(|i| cut.sums.get(i)).collect();

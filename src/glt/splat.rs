@@ -75,6 +75,7 @@ impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
             return SplatOutcome::Zero;
         }
         if cut.sums.add(index, value) {
+            cut.recorded.bump();
             SplatOutcome::Recorded
         } else {
             SplatOutcome::Dropped
