@@ -52,7 +52,8 @@
 //! | what | file |
 //! | --- | --- |
 //! | the GLT's sampling rule and pmf | `src/glt/sampling.rs` |
-//! | cut refinement (split / merge by sigma) | `src/glt/refine.rs` |
+//! | the light tree laid out for the GLT's walk | `src/glt/walk.rs` |
+//! | cut refinement (split / merge by sigma, `min_splats`) | `src/glt/refine.rs` |
 //! | light-tree build heuristics | `src/light_tree/build.rs` |
 //! | the importance of a light cluster | `src/light_sampler/importance.rs` |
 //! | the one-number descent | `src/math/descent.rs` |
