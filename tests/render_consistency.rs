@@ -34,7 +34,7 @@ mod scene;
 #[path = "../examples/render/scenes/mod.rs"]
 mod scenes;
 
-use guiding::glt::BelowCut;
+use guiding::glt::{BelowCut, CutConfig};
 use methods::{GuideParams, Method};
 use run::{Budget, Rendered, Settings};
 
@@ -86,7 +86,7 @@ fn methods_agree(name: &str, width: u32, height: u32, spp: u64) {
             spatial_threshold: 250.0,
             glt_spatial_threshold: 250.0,
             below_cut: BelowCut::Energy,
-            min_splats: 64,
+            min_splats: CutConfig::default().min_splats,
         },
         seed: 3,
         progress: false,
@@ -162,7 +162,7 @@ fn guided_methods_train_their_structures() {
             spatial_threshold: 250.0,
             glt_spatial_threshold: 250.0,
             below_cut: BelowCut::Energy,
-            min_splats: 64,
+            min_splats: CutConfig::default().min_splats,
         },
         seed: 5,
         progress: false,

@@ -75,7 +75,11 @@ impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
             return SplatOutcome::Zero;
         }
         if cut.sums.add(index, value) {
-            cut.recorded.bump();
+            // Only the data floor reads the count: the paper's rule
+            // (`min_splats` 0) pays no second atomic per splat.
+            if self.config().min_splats > 0 {
+                cut.recorded.bump();
+            }
             SplatOutcome::Recorded
         } else {
             SplatOutcome::Dropped

@@ -11,7 +11,8 @@
 //! children, and pairs are laid out depth-first so a subtree's pairs are
 //! near each other. On `ring` (24,576 emitters, `pt-glt`, 32 spp, one
 //! thread) the time in the walk fell from 2.9-3.2 s to 1.8-2.3 s (perf
-//! samples, two runs each).
+//! samples, two runs each; the command is in docs/benchmarks.md, "The walk
+//! table").
 //!
 //! `pmf` does not use it: it knows the emitter's path, so it reads the
 //! split table by node, loads that do not wait on each other.
