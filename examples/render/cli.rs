@@ -51,6 +51,10 @@ pub struct Args {
     /// (`guiding::glt::CutConfig::min_splats`; 0 = the paper's rule).
     #[arg(long, default_value_t = guiding::glt::CutConfig::default().min_splats)]
     pub min_splats: u32,
+    /// The GLT's defensive mixture weight alpha
+    /// (`guiding::glt::CutConfig::alpha`).
+    #[arg(long, default_value_t = guiding::glt::CutConfig::default().alpha)]
+    pub alpha: f64,
     /// Worker threads [default: all cores].
     #[arg(long)]
     pub threads: Option<usize>,

@@ -117,6 +117,7 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
             glt_spatial_threshold: args.glt_spatial_threshold,
             below_cut: args.below_cut,
             min_splats: args.min_splats,
+            alpha: args.alpha,
         },
         seed: args.seed,
         progress: !args.quiet,

@@ -99,6 +99,24 @@ pub struct GuideParams {
     pub below_cut: BelowCut,
     /// The fewest non-zero light splats a cut rebuilds from.
     pub min_splats: u32,
+    /// The weight of the GLT's defensive mixture with the energy prior.
+    pub alpha: f64,
+}
+
+impl Default for GuideParams {
+    /// The crate's defaults, with the render example's spatial thresholds
+    /// (see its `--spatial-threshold` and `--glt-spatial-threshold`).
+    fn default() -> Self {
+        let cut = CutConfig::default();
+        Self {
+            sigma: cut.sigma,
+            spatial_threshold: 4000.0,
+            glt_spatial_threshold: 250.0,
+            below_cut: cut.below_cut,
+            min_splats: cut.min_splats,
+            alpha: cut.alpha,
+        }
+    }
 }
 
 /// A fixed (untrained) light sampler for `method`, with the scene's
@@ -131,6 +149,7 @@ fn cut_config(scene: &Scene, params: &GuideParams) -> CutConfig {
         sigma: params.sigma,
         below_cut: params.below_cut,
         min_splats: params.min_splats,
+        alpha: params.alpha,
         environment: scene
             .environment
             .map(|_| f64::from(scene.environment_probability)),

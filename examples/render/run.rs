@@ -9,11 +9,14 @@ use crate::methods::{GuideParams, Method, fixed_sampler, new_field, new_glt, new
 use crate::rng::Sampler;
 use crate::scene::Scene;
 use glam::Vec3;
-use guiding::LightSampler;
+use guiding::field::GuidingField;
+use guiding::glt::Glt;
 use guiding::schedule::{
     InverseVarianceCombiner, Iteration, MAX_COMBINED, PassStats, next_iteration,
     next_iteration_by_time,
 };
+use guiding::sd_tree::SdTree;
+use guiding::{LightSampler, LightTree};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use std::collections::VecDeque;
@@ -124,8 +127,30 @@ struct Done {
     mean_var: f64,
 }
 
+/// The learned structures a render ends with (those its method trains):
+/// what its last iteration sampled from.
+#[allow(dead_code)] // the `render` example reads none of them; `light_limit` does
+pub struct Trained<'a> {
+    /// The Guiding Light Tree of `pt-glt`.
+    pub glt: Option<Glt<'a, LightTree>>,
+    /// The SD-tree of `ppg`.
+    pub sd_tree: Option<SdTree>,
+    /// The combined field of `ppg-glt`.
+    pub field: Option<GuidingField<'a, LightTree>>,
+}
+
 /// Renders `scene` with `method` within `settings.budget`.
 pub fn render(scene: &Scene, method: Method, settings: &Settings) -> Rendered {
+    render_trained(scene, method, settings).0
+}
+
+/// Like [`render`], also returning the learned structures as the last
+/// iteration used them (the `light_limit` example measures them).
+pub fn render_trained<'a>(
+    scene: &'a Scene,
+    method: Method,
+    settings: &Settings,
+) -> (Rendered, Trained<'a>) {
     let start = Instant::now();
     let (w, h) = (settings.width, settings.height);
     let len = (3 * w * h) as usize;
@@ -250,7 +275,7 @@ pub fn render(scene: &Scene, method: Method, settings: &Settings) -> Rendered {
         }
     }
     let image: Vec<Vec3> = flat.chunks_exact(3).map(Vec3::from_slice).collect();
-    Rendered {
+    let rendered = Rendered {
         width: w,
         height: h,
         mean: mean_luminance(&flat),
@@ -270,7 +295,13 @@ pub fn render(scene: &Scene, method: Method, settings: &Settings) -> Rendered {
             }),
         glt_bytes: glt.as_ref().map_or(0, |g| g.memory().total())
             + field.as_ref().map_or(0, |f| f.memory().cut_bytes()),
-    }
+    };
+    let learned = Trained {
+        glt,
+        sd_tree,
+        field,
+    };
+    (rendered, learned)
 }
 
 /// Mean luminance of an RGB buffer.

@@ -1,0 +1,56 @@
+//! A GLT configuration to measure, from a `key=value` list.
+
+use crate::methods::GuideParams;
+use guiding::glt::BelowCut;
+
+/// One GLT configuration and how long it trains.
+#[derive(Clone, Debug)]
+pub struct GltVariant {
+    /// The method name in the table (`glt` for the defaults).
+    pub name: String,
+    /// The learned structure's parameters.
+    pub params: GuideParams,
+    /// Samples per pixel of training (the render schedule).
+    pub train_spp: u64,
+}
+
+impl GltVariant {
+    /// The crate's defaults, trained as the render example trains `pt-glt`.
+    pub fn defaults(train_spp: u64) -> Self {
+        Self {
+            name: "glt".into(),
+            params: GuideParams::default(),
+            train_spp,
+        }
+    }
+
+    /// Parses `spec`: space-separated `key=value` (sigma, alpha,
+    /// below=energy|importance, min-splats, threshold, train-spp) applied
+    /// to the defaults.
+    pub fn parse(spec: &str, train_spp: u64) -> Result<Self, String> {
+        let mut v = Self::defaults(train_spp);
+        for kv in spec.split_whitespace() {
+            let (k, val) = kv
+                .split_once('=')
+                .ok_or_else(|| format!("`{kv}`: expected key=value"))?;
+            let num = || val.parse::<f64>().map_err(|e| format!("`{kv}`: {e}"));
+            match k {
+                "sigma" => v.params.sigma = num()?,
+                "alpha" => v.params.alpha = num()?,
+                "threshold" => v.params.glt_spatial_threshold = num()?,
+                "min-splats" => v.params.min_splats = num()? as u32,
+                "train-spp" => v.train_spp = num()? as u64,
+                "below" => {
+                    v.params.below_cut = match val {
+                        "energy" => BelowCut::Energy,
+                        "importance" => BelowCut::Importance,
+                        _ => return Err(format!("`{kv}`: energy or importance")),
+                    }
+                }
+                _ => return Err(format!("`{kv}`: unknown key {k:?}")),
+            }
+        }
+        v.name = format!("glt {}", spec.trim());
+        Ok(v)
+    }
+}

@@ -1,0 +1,315 @@
+//! `light_limit`: how far a light sampler is from the best light choice
+//! physically possible, measured exactly, without timing noise.
+//!
+//! At shading points of the render example's scenes (first non-specular
+//! hits of camera rays, or the k-th vertex) it computes every light's
+//! contribution by brute force with real shadow rays, then the exact
+//! per-sample variance of the render example's direct-light estimator (one
+//! NEE sample + one BSDF sample, power-heuristic MIS; `variance.rs`) under
+//! each light-selection pmf: uniform, power, the light BVH's importance,
+//! the Guiding Light Tree as the render example trains it for `pt-glt`
+//! (crate defaults, and any variants given with `--glt`), and the
+//! clairvoyant pmf (proportional to the square root of each light's second
+//! moment, from held-out samples that do not evaluate it).
+//!
+//! ```text
+//! cargo run --release --example light_limit -- --scene city,ring,torus --points 300 --json out/light_limit.json
+//! cargo run --release --example light_limit -- --scene city --glt "sigma=0.002" --glt "alpha=0.1 below=importance"
+//! ```
+//!
+//! The scene, geometry and training code are the render example's own
+//! files (`#[path]`), so the GLT measured is exactly the one `pt-glt`
+//! renders with.
+
+#![allow(dead_code)]
+
+#[path = "../render/bvh.rs"]
+mod bvh;
+#[path = "../render/camera.rs"]
+mod camera;
+#[path = "../render/geometry.rs"]
+mod geometry;
+#[path = "../render/integrator.rs"]
+mod integrator;
+#[path = "../render/lights.rs"]
+mod lights;
+#[path = "../render/materials.rs"]
+mod materials;
+#[path = "../render/methods.rs"]
+mod methods;
+#[path = "../render/rng.rs"]
+mod rng;
+#[path = "../render/run.rs"]
+mod run;
+#[path = "../render/scene.rs"]
+mod scene;
+#[path = "../render/scenes/mod.rs"]
+mod scenes;
+
+mod brute_force;
+mod glt_variant;
+mod shading_points;
+mod variance;
+
+use brute_force::PointTerms;
+use clap::Parser;
+use glt_variant::GltVariant;
+use guiding::{LightId, LightSampler, ShadingContext};
+use methods::Method;
+use rayon::prelude::*;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Measures the exact per-sample variance of light selection against the
+/// clairvoyant pmf at shading points of the render example's scenes.
+#[derive(Parser, Debug)]
+#[command(name = "light_limit", version)]
+struct Args {
+    /// Scenes, comma separated (the render example's names).
+    #[arg(long, value_delimiter = ',', default_value = "city,ring,torus")]
+    scene: Vec<String>,
+    /// Shading points per scene.
+    #[arg(long, default_value_t = 300)]
+    points: usize,
+    /// Which non-specular vertex of a camera path to measure at (1 = first
+    /// hit).
+    #[arg(long, default_value_t = 1)]
+    vertex: u32,
+    /// Light samples per light in each of the two sets (evaluation,
+    /// held-out).
+    #[arg(long, default_value_t = 4)]
+    light_samples: usize,
+    /// BSDF samples per point.
+    #[arg(long, default_value_t = 64)]
+    bsdf_samples: usize,
+    /// GLT variants besides the defaults: space-separated `key=value`
+    /// settings (sigma, alpha, below=energy|importance, min-splats,
+    /// threshold, train-spp); repeat the flag for several.
+    #[arg(long)]
+    glt: Vec<String>,
+    /// Samples per pixel the GLT trains with (the render example's
+    /// schedule; the GLT measured is what its last iteration samples).
+    #[arg(long, default_value_t = 128)]
+    train_spp: u64,
+    /// Image size the GLT trains at and the points are picked from.
+    #[arg(long, default_value_t = 256)]
+    width: u32,
+    /// Image height.
+    #[arg(long, default_value_t = 192)]
+    height: u32,
+    /// Seed of the points, the brute-force samples and the training.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Worker threads [default: all cores].
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Smaller scenes, as the tests use.
+    #[arg(long)]
+    small: bool,
+    /// Write the records as a JSON array here.
+    #[arg(long)]
+    json: Option<PathBuf>,
+}
+
+/// One measured method on one scene.
+struct Record {
+    scene: String,
+    method: String,
+    rel_variance: f64,
+    points: usize,
+    glt_bytes: usize,
+    train_spp: u64,
+}
+
+fn main() -> ExitCode {
+    let args = Args::parse();
+    match run(&args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(args: &Args) -> Result<(), String> {
+    if let Some(n) = args.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .map_err(|e| e.to_string())?;
+    }
+    let mut variants = vec![GltVariant::defaults(args.train_spp)];
+    for spec in &args.glt {
+        variants.push(GltVariant::parse(spec, args.train_spp)?);
+    }
+    let mut all = Vec::new();
+    for name in &args.scene {
+        let records = measure_scene(args, name, &variants)?;
+        print!("{}", table(&records));
+        all.extend(records);
+    }
+    if let Some(path) = &args.json {
+        std::fs::write(path, to_json(&all)).map_err(|e| format!("{}: {e}", path.display()))?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// The pmf of every contributing light at every point under `sampler`.
+fn pmfs_of(
+    points: &[PointTerms],
+    pmf: impl Fn(&ShadingContext, LightId) -> f64 + Sync,
+) -> Vec<f64> {
+    let v: Vec<f64> = points
+        .par_iter()
+        .map(|t| {
+            let ctx = ShadingContext::on_surface(t.at.p, t.at.n);
+            let pmfs: Vec<f64> = t.lights.iter().map(|l| pmf(&ctx, l.light)).collect();
+            variance::variance(t, &pmfs)
+        })
+        .collect();
+    v
+}
+
+fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec<Record>, String> {
+    let size = if args.small {
+        scenes::Size::Small
+    } else {
+        scenes::Size::Full
+    };
+    let scene = scenes::build(name, size).ok_or_else(|| format!("unknown scene {name:?}"))?;
+    let t = Instant::now();
+    let at = shading_points::pick(
+        &scene,
+        args.points,
+        args.vertex,
+        (args.width, args.height),
+        args.seed,
+    );
+    let points: Vec<PointTerms> = at
+        .par_iter()
+        .enumerate()
+        .map(|(i, &p)| {
+            brute_force::measure(
+                &scene,
+                p,
+                args.light_samples,
+                args.bsdf_samples,
+                rng::mix64(args.seed ^ i as u64),
+            )
+        })
+        .collect();
+    let contributing: usize = points.iter().map(|t| t.lights.len()).sum();
+    println!(
+        "scene {name}: {} emitters, {} points, {:.0} contributing lights per point on average; brute force {:.1} s",
+        scene.lights.len(),
+        points.len(),
+        contributing as f64 / points.len().max(1) as f64,
+        t.elapsed().as_secs_f64()
+    );
+    let record = |method: &str, variances: &[f64], glt_bytes: usize, train_spp: u64| Record {
+        scene: name.to_string(),
+        method: method.to_string(),
+        rel_variance: variance::relative(&points, variances),
+        points: points.len(),
+        glt_bytes,
+        train_spp,
+    };
+    let mut records = Vec::new();
+    for (label, method) in [
+        ("uniform", Method::PtUniform),
+        ("power", Method::PtPower),
+        ("bvh", Method::PtBvh),
+    ] {
+        let sampler = methods::fixed_sampler(&scene, method).ok_or("a fixed sampler")?;
+        let v = pmfs_of(&points, |ctx, l| f64::from(sampler.pmf(ctx, l)));
+        records.push(record(label, &v, 0, 0));
+    }
+    for variant in variants {
+        let t = Instant::now();
+        let settings = run::Settings {
+            width: args.width,
+            height: args.height,
+            budget: run::Budget::Spp(variant.train_spp),
+            params: variant.params,
+            seed: args.seed,
+            progress: false,
+        };
+        let (_, trained) = run::render_trained(&scene, Method::PtGlt, &settings);
+        let glt = trained.glt.ok_or("pt-glt trains a GLT")?;
+        let v = pmfs_of(&points, |ctx, l| f64::from(glt.pmf(ctx, l)));
+        records.push(record(
+            &variant.name,
+            &v,
+            glt.memory().total(),
+            variant.train_spp,
+        ));
+        println!(
+            "  {}: trained {} spp in {:.1} s",
+            variant.name,
+            variant.train_spp,
+            t.elapsed().as_secs_f64()
+        );
+    }
+    let v: Vec<f64> = points
+        .par_iter()
+        .map(|t| variance::variance(t, &variance::clairvoyant(t)))
+        .collect();
+    records.push(record("clairvoyant", &v, 0, 0));
+    Ok(records)
+}
+
+/// The printed table of one scene.
+fn table(records: &[Record]) -> String {
+    let clair = records
+        .iter()
+        .find(|r| r.method == "clairvoyant")
+        .map_or(f64::NAN, |r| r.rel_variance);
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "| scene | method | rel. variance | / clairvoyant | GLT MB |"
+    );
+    let _ = writeln!(s, "|---|---|---:|---:|---:|");
+    for r in records {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.4} | {:.1}x | {:.2} |",
+            r.scene,
+            r.method,
+            r.rel_variance,
+            r.rel_variance / clair,
+            r.glt_bytes as f64 / 1e6
+        );
+    }
+    s
+}
+
+/// The records as a JSON array.
+fn to_json(records: &[Record]) -> String {
+    let num = |x: f64| {
+        if x.is_finite() {
+            format!("{x}")
+        } else {
+            "null".into()
+        }
+    };
+    let items: Vec<String> = records
+        .iter()
+        .map(|r| {
+            format!(
+                "  {{\"scene\": \"{}\", \"method\": \"{}\", \"rel_variance\": {}, \"points\": {}, \"glt_bytes\": {}, \"train_spp\": {}}}",
+                r.scene,
+                r.method.replace('"', "'"),
+                num(r.rel_variance),
+                r.points,
+                r.glt_bytes,
+                r.train_spp
+            )
+        })
+        .collect();
+    format!("[\n{}\n]\n", items.join(",\n"))
+}
