@@ -227,6 +227,7 @@ fn equals_a_glt_fed_the_same_light_splats() {
             cut,
             spatial_threshold: 200.0,
             spatial_budget: None,
+            filter: SpatialFilter::StochasticBox,
         },
     )
     .unwrap();

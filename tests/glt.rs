@@ -6,7 +6,8 @@
 
 use glam::Vec3;
 use guiding::glt::{
-    BelowCut, CutConfig, CutNode, GuidingCut, GuidingTree, Slot, SplatOutcome, SplitPrior,
+    BelowCut, CutConfig, CutNode, GuidingCut, GuidingTree, Modulation, Slot, SplatOutcome,
+    SplitPrior,
 };
 use guiding::light_tree::{BuildHeuristic, EmitterPath, NodeBounds};
 use guiding::math::{Aabb, Accumulation, LightCone, Side};
@@ -226,23 +227,31 @@ fn config_strategy() -> impl Strategy<Value = CutConfig> {
         ],
         any::<bool>(),
         prop_oneof![Just(0u32), Just(1), Just(64)],
+        any::<bool>(),
     )
-        .prop_map(|(sigma, alpha, variant, environment, exact, min_splats)| {
-            let (below_cut, split_prior) = ALL_CONFIGS[variant];
-            CutConfig {
-                sigma,
-                alpha,
-                below_cut,
-                split_prior,
-                environment,
-                accumulation: if exact {
-                    Accumulation::Deterministic
-                } else {
-                    Accumulation::Fast
-                },
-                min_splats,
-            }
-        })
+        .prop_map(
+            |(sigma, alpha, variant, environment, exact, min_splats, modulate)| {
+                let (below_cut, split_prior) = ALL_CONFIGS[variant];
+                CutConfig {
+                    sigma,
+                    alpha,
+                    below_cut,
+                    modulation: if modulate {
+                        Modulation::Importance
+                    } else {
+                        Modulation::None
+                    },
+                    split_prior,
+                    environment,
+                    accumulation: if exact {
+                        Accumulation::Deterministic
+                    } else {
+                        Accumulation::Fast
+                    },
+                    min_splats,
+                }
+            },
+        )
 }
 
 const HEURISTICS: [BuildHeuristic; 4] = [
@@ -284,7 +293,7 @@ proptest! {
                     1 => LightId::Emitter(n + id),
                     _ => LightId::Emitter(id % n),
                 };
-                let outcome = guide.splat(&cut, light, value.get());
+                let outcome = guide.splat_from(&cut, rng.point(3.0), light, value.get());
                 let dark = match light {
                     LightId::Emitter(e) => e >= n || lights[e as usize].power == 0.0,
                     LightId::Environment => config.environment.is_none(),
@@ -1135,4 +1144,83 @@ fn chain_hierarchy_is_consistent() {
         let parent = chain.parent(node).unwrap();
         assert!(chain.children(parent).unwrap().contains(&node));
     }
+}
+
+// ---------------------------------------------------------------------------
+// Modulation by importance inside a cell
+// ---------------------------------------------------------------------------
+
+/// With [`Modulation::Importance`] the learned distribution is reproduced
+/// at the cell's anchor (the mean splat position) and follows the
+/// importance away from it: at the anchor every emitter's pmf equals the
+/// unmodulated cut's (to f32 rounding); near one end of a row of lights the
+/// near lights gain and the second moment of sampling the contributions
+/// there falls; the pmf still sums to 1 with sample == pmf bit for bit.
+#[test]
+fn modulation_reproduces_the_learned_cut_at_the_anchor_and_follows_importance() {
+    // 32 equal point lights on a row along x, 1 above the floor.
+    let lights: Vec<Emitter> = (0..32)
+        .map(|i| Emitter::point(Vec3::new(i as f32, 1.0, 0.0), 1.0))
+        .collect();
+    let tree = LightTree::build(&lights, BuildHeuristic::Sah).unwrap();
+    let make = |modulation| {
+        GuidingTree::new(
+            &tree,
+            CutConfig {
+                modulation,
+                min_splats: 0,
+                sigma: 0.001,
+                ..CutConfig::default()
+            },
+        )
+    };
+    let (plain, modulated) = (make(Modulation::None), make(Modulation::Importance));
+    let (mut a, mut b) = (plain.new_cut(), modulated.new_cut());
+    // Every splat is made at the anchor (the middle of the row), with the
+    // inverse-square contribution there.
+    let anchor = Vec3::new(15.5, 0.0, 0.0);
+    for _ in 0..3 {
+        for (i, e) in lights.iter().enumerate() {
+            let v = 1.0 / (e.bounds.center() - anchor).length_squared();
+            plain.splat_from(&a, anchor, LightId::Emitter(i as u32), v);
+            modulated.splat_from(&b, anchor, LightId::Emitter(i as u32), v);
+        }
+        plain.refine(&mut a);
+        modulated.refine(&mut b);
+    }
+    let at = ShadingContext::at(anchor);
+    for i in 0..32 {
+        let (p, q) = (
+            plain.pmf_exact(&a, &at, LightId::Emitter(i)),
+            modulated.pmf_exact(&b, &at, LightId::Emitter(i)),
+        );
+        assert!((p - q).abs() <= 1e-5 * p, "light {i} at the anchor: {p} vs {q}");
+    }
+    // Near the row's start the first lights matter far more than at the
+    // anchor; the plain cut cannot know.
+    let near = ShadingContext::at(Vec3::new(0.0, 0.0, 0.0));
+    let first = |g: &GuidingTree<LightTree>, c| g.pmf_exact(c, &near, LightId::Emitter(0));
+    assert!(
+        first(&modulated, &b) > 3.0 * first(&plain, &a),
+        "near light: {} vs {}",
+        first(&modulated, &b),
+        first(&plain, &a)
+    );
+    // And it samples the near point's inverse-square contributions with a
+    // lower second moment, sum c^2 / p.
+    let m2 = |g: &GuidingTree<LightTree>, c| {
+        (0..32u32)
+            .map(|i| {
+                let d2 = (lights[i as usize].bounds.center() - near.position).length_squared();
+                let c2 = 1.0 / (d2 as f64 * d2 as f64);
+                c2 / g.pmf_exact(c, &near, LightId::Emitter(i))
+            })
+            .sum::<f64>()
+    };
+    let (m_plain, m_mod) = (m2(&plain, &a), m2(&modulated, &b));
+    assert!(m_mod < 0.5 * m_plain, "second moment {m_mod} vs {m_plain}");
+    let total = pmf_total(&modulated, &b, &near);
+    assert!((total - 1.0).abs() < 1e-9, "pmf sums to {total}");
+    let mut rng = Rand::new(5);
+    assert_sample_matches_pmf(&modulated, &b, &near, &mut rng, 200);
 }

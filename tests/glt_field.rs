@@ -7,6 +7,7 @@ use glam::Vec3;
 use guiding::glt::{CutConfig, Glt, GltConfig, GltMemory, SplatOutcome};
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Accumulation;
+use guiding::spatial::SpatialFilter;
 use guiding::spatial::SpatialTree;
 use guiding::{Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext};
 
@@ -150,6 +151,7 @@ fn jitter_spreads_over_neighbouring_cells() {
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
     let config = GltConfig {
         spatial_threshold: 10.0,
+        filter: SpatialFilter::StochasticBox,
         ..GltConfig::default()
     };
     let mut glt = Glt::new(&tree, scene(), config).unwrap();

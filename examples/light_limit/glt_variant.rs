@@ -1,7 +1,8 @@
 //! A GLT configuration to measure, from a `key=value` list.
 
 use crate::methods::GuideParams;
-use guiding::glt::BelowCut;
+use guiding::glt::{BelowCut, Modulation};
+use guiding::spatial::SpatialFilter;
 
 /// One GLT configuration and how long it trains.
 #[derive(Clone, Debug)]
@@ -25,7 +26,9 @@ impl GltVariant {
     }
 
     /// Parses `spec`: space-separated `key=value` (sigma, alpha,
-    /// below=energy|importance, min-splats, threshold, train-spp) applied
+    /// below=energy|importance, modulation=none|importance,
+    /// splat=radiance|contribution, filter=nearest|jitter, min-splats,
+    /// threshold, train-spp) applied
     /// to the defaults.
     pub fn parse(spec: &str, train_spp: u64) -> Result<Self, String> {
         let mut v = Self::defaults(train_spp);
@@ -45,6 +48,27 @@ impl GltVariant {
                         "energy" => BelowCut::Energy,
                         "importance" => BelowCut::Importance,
                         _ => return Err(format!("`{kv}`: energy or importance")),
+                    }
+                }
+                "modulation" => {
+                    v.params.modulation = match val {
+                        "none" => Modulation::None,
+                        "importance" => Modulation::Importance,
+                        _ => return Err(format!("`{kv}`: none or importance")),
+                    }
+                }
+                "splat" => {
+                    v.params.contribution_splats = match val {
+                        "radiance" => false,
+                        "contribution" => true,
+                        _ => return Err(format!("`{kv}`: radiance or contribution")),
+                    }
+                }
+                "filter" => {
+                    v.params.glt_filter = match val {
+                        "nearest" => SpatialFilter::Nearest,
+                        "jitter" => SpatialFilter::StochasticBox,
+                        _ => return Err(format!("`{kv}`: nearest or jitter")),
                     }
                 }
                 _ => return Err(format!("`{kv}`: unknown key {k:?}")),

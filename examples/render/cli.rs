@@ -1,7 +1,7 @@
 //! The command line.
 
 use clap::Parser;
-use guiding::glt::BelowCut;
+use guiding::glt::{BelowCut, Modulation};
 use std::path::PathBuf;
 
 /// Renders the paper's scene analogues with every light-sampling and
@@ -55,6 +55,19 @@ pub struct Args {
     /// (`guiding::glt::CutConfig::alpha`).
     #[arg(long, default_value_t = guiding::glt::CutConfig::default().alpha)]
     pub alpha: f64,
+    /// Whether the GLT's cut probabilities vary inside a cell: `none` (the
+    /// paper) or `importance` (learned factor x importance at the point).
+    #[arg(long, default_value = "none", value_parser = parse_modulation)]
+    pub modulation: Modulation,
+    /// Light splats carry the full contribution `f cos Le w / p` instead of
+    /// the paper's `Le w / p`.
+    #[arg(long)]
+    pub contribution_splats: bool,
+    /// The GLT's light splats (`pt-glt`) jitter into neighbouring cells
+    /// (PPG's stochastic box, as the paper does) instead of going to the
+    /// shading point's own cell.
+    #[arg(long)]
+    pub glt_jitter: bool,
     /// Worker threads [default: all cores].
     #[arg(long)]
     pub threads: Option<usize>,
@@ -93,6 +106,15 @@ pub struct Args {
     /// No progress bars.
     #[arg(long)]
     pub quiet: bool,
+}
+
+/// Parses `--modulation`.
+pub fn parse_modulation(s: &str) -> Result<Modulation, String> {
+    match s {
+        "none" => Ok(Modulation::None),
+        "importance" => Ok(Modulation::Importance),
+        _ => Err(format!("`{s}`: expected `none` or `importance`")),
+    }
 }
 
 /// Parses `--below-cut`.

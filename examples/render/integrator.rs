@@ -31,6 +31,9 @@ pub struct Guides<'a> {
     pub field: Option<&'a GuidingField<'a, LightTree>>,
     /// Whether to record training data this pass.
     pub train: bool,
+    /// Light splats carry the full contribution `f cos Le w / p` instead of
+    /// the paper's `Le w / p` (without the BSDF and cosine).
+    pub contribution_splats: bool,
 }
 
 /// The field's cell at a path vertex (`ppg-glt`): found once, it serves
@@ -58,6 +61,8 @@ struct Vertex<'a> {
     pos: Vec3,
     normal: Vec3,
     pdf_dir: f32,
+    /// `f cos` of the direction sampled here (for contribution splats).
+    f_cos: Vec3,
     delta: bool,
 }
 
@@ -107,6 +112,17 @@ fn splat_light(guides: &Guides, v: &Vertex, light: LightId, value: f32, s: &mut 
         at.splat_light(light, value, s.rng());
     } else if let Some(field) = guides.field {
         field.splat_light(v.pos, light, value, s.rng());
+    }
+}
+
+/// The scalar a light splat starts from: the luminance of the arriving
+/// radiance `le`, times `f cos` with contribution splats.
+#[inline]
+fn splat_value(guides: &Guides, f_cos: Vec3, le: Vec3) -> f32 {
+    if guides.contribution_splats {
+        luminance(f_cos * le)
+    } else {
+        luminance(le)
     }
 }
 
@@ -176,7 +192,7 @@ pub fn radiance<'a>(
                     && !v.delta
                     && pdf_dir > 0.0
                 {
-                    let value = luminance(env.radiance) * w / pdf_dir;
+                    let value = splat_value(guides, v.f_cos, env.radiance) * w / pdf_dir;
                     if value > 0.0 {
                         splat_light(guides, &v, LightId::Environment, value, s);
                     }
@@ -208,7 +224,7 @@ pub fn radiance<'a>(
                     && !v.delta
                     && pdf_dir > 0.0
                 {
-                    let value = luminance(le) * w / pdf_dir;
+                    let value = splat_value(guides, v.f_cos, le) * w / pdf_dir;
                     if value > 0.0 {
                         splat_light(guides, &v, id, value, s);
                     }
@@ -230,6 +246,7 @@ pub fn radiance<'a>(
                 pos: p,
                 normal: ng,
                 pdf_dir: 0.0,
+                f_cos: Vec3::ONE,
                 delta: true,
             });
             origin = offset_origin(p, ng, bs.wi);
@@ -245,6 +262,7 @@ pub fn radiance<'a>(
             pos: p,
             normal: n,
             pdf_dir: 0.0,
+            f_cos: Vec3::ONE,
             delta: false,
         };
         let cell = match (field_vertex, guides.sd_tree) {
@@ -289,7 +307,7 @@ pub fn radiance<'a>(
                         if c.is_finite() {
                             contribute(&mut l, records, c);
                             if train_light {
-                                let value = luminance(lp.radiance) * w / p_light;
+                                let value = splat_value(guides, f, lp.radiance) * w / p_light;
                                 splat_light(guides, &here, ls.light, value, s);
                             }
                         }
@@ -334,6 +352,7 @@ pub fn radiance<'a>(
         }
         prev = Some(Vertex {
             pdf_dir: pdf,
+            f_cos,
             ..here
         });
         origin = offset_origin(p, n, wi);

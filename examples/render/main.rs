@@ -34,6 +34,7 @@ mod scenes;
 mod sheet;
 
 use clap::Parser;
+use guiding::spatial::SpatialFilter;
 use methods::{GuideParams, Method};
 use report::Record;
 use run::{Budget, Settings};
@@ -118,6 +119,13 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
             below_cut: args.below_cut,
             min_splats: args.min_splats,
             alpha: args.alpha,
+            modulation: args.modulation,
+            contribution_splats: args.contribution_splats,
+            glt_filter: if args.glt_jitter {
+                SpatialFilter::StochasticBox
+            } else {
+                SpatialFilter::Nearest
+            },
         },
         seed: args.seed,
         progress: !args.quiet,

@@ -4,11 +4,12 @@
 
 use crate::scene::Scene;
 use guiding::field::{FieldConfig, GuidingField};
-use guiding::glt::{BelowCut, CutConfig, Glt, GltConfig};
+use guiding::glt::{BelowCut, CutConfig, Glt, GltConfig, Modulation};
 use guiding::light_sampler::{
     ImportanceTreeSampler, PowerSampler, UniformSampler, WithEnvironment,
 };
 use guiding::sd_tree::{SdTree, SdTreeConfig};
+use guiding::spatial::SpatialFilter;
 use guiding::{LightSampler, LightTree};
 
 /// A way to render: a light sampler for NEE, optionally with PPG's
@@ -101,6 +102,12 @@ pub struct GuideParams {
     pub min_splats: u32,
     /// The weight of the GLT's defensive mixture with the energy prior.
     pub alpha: f64,
+    /// Whether the GLT's cut probabilities vary inside a cell.
+    pub modulation: Modulation,
+    /// Light splats carry `f cos Le w / p` (else the paper's `Le w / p`).
+    pub contribution_splats: bool,
+    /// The spatial filter of the GLT's light splats (`pt-glt`).
+    pub glt_filter: SpatialFilter,
 }
 
 impl Default for GuideParams {
@@ -115,6 +122,9 @@ impl Default for GuideParams {
             below_cut: cut.below_cut,
             min_splats: cut.min_splats,
             alpha: cut.alpha,
+            modulation: cut.modulation,
+            contribution_splats: false,
+            glt_filter: GltConfig::default().filter,
         }
     }
 }
@@ -150,6 +160,7 @@ fn cut_config(scene: &Scene, params: &GuideParams) -> CutConfig {
         below_cut: params.below_cut,
         min_splats: params.min_splats,
         alpha: params.alpha,
+        modulation: params.modulation,
         environment: scene
             .environment
             .map(|_| f64::from(scene.environment_probability)),
@@ -200,6 +211,7 @@ pub fn new_glt<'a>(
         cut: cut_config(scene, params),
         spatial_threshold: params.glt_spatial_threshold,
         spatial_budget: None,
+        filter: params.glt_filter,
     };
     Some(Glt::new(&scene.light_tree, scene.bounds, config).expect("scene bounds are finite"))
 }

@@ -214,6 +214,7 @@ pub fn render_trained<'a>(
                 sd_tree: sd_tree.as_ref(),
                 field: field.as_ref(),
                 train: trained && !it.is_last,
+                contribution_splats: settings.params.contribution_splats,
             };
             render_pass(scene, &guides, settings, spp, &mut pass_buf);
             stats.add_pass(&pass_buf);

@@ -24,6 +24,39 @@ pub enum BelowCut {
     Importance,
 }
 
+/// Whether the cut's learned probabilities vary with the shading point
+/// inside a cell.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Modulation {
+    /// One distribution for the whole cell: at a cut node the left child
+    /// has the learned probability `p_left`, wherever the shading point
+    /// is (the paper).
+    #[default]
+    None,
+    /// The learned quantity is a per-cluster correction factor on top of
+    /// the analytic importance (`crate::light_sampler::importance`): at
+    /// refinement each slot's learned weight is divided by its cluster's
+    /// importance at the cell's anchor (the mean position of the splats it
+    /// learned from), and at a query point `x` the two children of a cut
+    /// node are chosen in proportion to factor x importance at `x`:
+    ///
+    /// ```text
+    /// p_left(x) = r I_l(x) / (r I_l(x) + (1 - r) I_r(x)),
+    /// r = (W_l / I_l(a)) / (W_l / I_l(a) + W_r / I_r(a))
+    /// ```
+    ///
+    /// (`W` the learned weights, `a` the anchor). At the anchor this is the
+    /// learned distribution; elsewhere it follows how the clusters'
+    /// distance and orientation change across the cell, which the paper's
+    /// constant distribution cannot. The factor keeps what the analytic
+    /// bound misses (visibility, the BSDF). Where both importances at `x`
+    /// are zero the step falls back to `r`. Splats must carry their
+    /// position for the anchor ([`crate::glt::Glt`] and the combined field
+    /// do; a cut splatted through [`crate::glt::GuidingTree::splat`] alone
+    /// has no anchor and keeps plain learned probabilities).
+    Importance,
+}
+
 /// How a slot that is split for the first time shares its learned weight
 /// between its two new children (they have no statistics of their own yet).
 ///
@@ -79,6 +112,9 @@ pub struct CutConfig {
     pub alpha: f64,
     /// How to continue below the cut. Default [`BelowCut::Energy`].
     pub below_cut: BelowCut,
+    /// Whether the cut's probabilities vary inside a cell. Default
+    /// [`Modulation::None`].
+    pub modulation: Modulation,
     /// How a newly split slot's weight is shared. Default
     /// [`SplitPrior::Half`].
     pub split_prior: SplitPrior,
@@ -110,6 +146,7 @@ impl Default for CutConfig {
             sigma: 0.01,
             alpha: 0.2,
             below_cut: BelowCut::Energy,
+            modulation: Modulation::None,
             split_prior: SplitPrior::Half,
             environment: None,
             accumulation: Accumulation::Fast,

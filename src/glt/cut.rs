@@ -7,6 +7,7 @@ use crate::light_tree::LightHierarchy;
 use crate::math::{Counter, Side, SumBuffer};
 use alloc::vec;
 use alloc::vec::Vec;
+use glam::Vec3;
 
 /// One cell's guiding cut: a weighted sub-tree of the global light tree from
 /// its root down to the cut (the paper's Figure 2, right), in two copies.
@@ -34,6 +35,11 @@ pub struct GuidingCut {
     /// Non-zero splats recorded since the last rebuild (see
     /// [`CutConfig::min_splats`]).
     pub(super) recorded: Counter,
+    /// Weighted sums of the positions splats came from (see `anchor_sums`),
+    /// since the last rebuild: the anchor of
+    /// [`Modulation::Importance`](super::Modulation::Importance). Empty
+    /// (no sums) without modulation.
+    pub(super) anchor: SumBuffer,
 }
 
 /// Why [`GuidingCut::check`] rejected a cut.
@@ -125,6 +131,7 @@ impl GuidingCut {
             sums,
             env_fraction: config.environment.unwrap_or(0.0) as f32,
             recorded: Counter::new(),
+            anchor: SumBuffer::new(anchor_sums(&config), config.accumulation),
         }
     }
 
@@ -239,20 +246,67 @@ impl GuidingCut {
         CutMemory {
             nodes: self.nodes.len(),
             node_bytes: self.nodes.len() * CutNode::BYTES,
-            sum_bytes: self.sums.bytes(),
+            sum_bytes: self.sums.bytes() + self.anchor.bytes(),
             inline_bytes: core::mem::size_of::<Self>(),
         }
     }
 
     /// Heap bytes (nodes and sums), without the value itself.
     pub fn heap_bytes(&self) -> usize {
-        self.nodes.len() * CutNode::BYTES + self.sums.bytes()
+        self.nodes.len() * CutNode::BYTES + self.sums.bytes() + self.anchor.bytes()
+    }
+
+    /// Adds the position `p` a splat came from, with `weight` (its share
+    /// of the splat after filtering), to the anchor's sums. Non-finite
+    /// positions and cuts without anchor sums are ignored.
+    #[inline]
+    pub(crate) fn record_position(&self, p: Vec3, weight: f32) {
+        if self.anchor.is_empty() || !p.is_finite() || weight.is_nan() || weight <= 0.0 {
+            return;
+        }
+        // The sums take non-negative values: each coordinate's positive and
+        // negative parts go to sums of their own.
+        for (i, x) in p.to_array().into_iter().enumerate() {
+            let v = x * weight;
+            if v >= 0.0 {
+                self.anchor.add(i, v);
+            } else {
+                self.anchor.add(3 + i, -v);
+            }
+        }
+        self.anchor.add(6, weight);
+    }
+
+    /// The mean position the splats since the last rebuild came from;
+    /// `None` when none carried a position.
+    pub fn anchor(&self) -> Option<Vec3> {
+        if self.anchor.is_empty() {
+            return None;
+        }
+        let w = self.anchor.get(6);
+        if w.is_nan() || w <= 0.0 {
+            return None;
+        }
+        let c = |i| ((self.anchor.get(i) - self.anchor.get(3 + i)) / w) as f32;
+        let a = Vec3::new(c(0), c(1), c(2));
+        a.is_finite().then_some(a)
     }
 
     /// Index of the environment light's sum.
     #[inline]
     pub(super) fn env_sum(&self) -> usize {
         sum_count(self.nodes.len()) - 1
+    }
+}
+
+/// Sums of the anchor position when the cut's probabilities are
+/// modulated (the positive and negative parts of x, y, z and the weight),
+/// none otherwise.
+#[inline]
+pub(super) fn anchor_sums(config: &CutConfig) -> usize {
+    match config.modulation {
+        super::Modulation::None => 0,
+        super::Modulation::Importance => 7,
     }
 }
 

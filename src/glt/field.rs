@@ -31,6 +31,14 @@ pub struct GltConfig {
     /// Cap, in bytes, on spatial tree plus cuts when splitting cells (the
     /// cuts are charged at their size before the split); `None` for none.
     pub spatial_budget: Option<usize>,
+    /// The spatial filter of [`Glt::splat`]. Default
+    /// [`SpatialFilter::Nearest`]: the estimate goes to the cell holding
+    /// the shading point. A jittering filter carries a splat into the
+    /// neighbouring cells, also through walls, where the light it saw may
+    /// be invisible; a dim room beside bright ones then learns its
+    /// neighbours' lights and samples worse than without learning
+    /// (`tests/glt_walls.rs`).
+    pub filter: SpatialFilter,
 }
 
 impl Default for GltConfig {
@@ -39,6 +47,7 @@ impl Default for GltConfig {
             cut: CutConfig::default(),
             spatial_threshold: 12000.0,
             spatial_budget: None,
+            filter: SpatialFilter::Nearest,
         }
     }
 }
@@ -203,14 +212,14 @@ impl<'a, H: LightHierarchy + ?Sized> Glt<'a, H> {
     }
 
     /// Records a direct-light estimate `value` for `light` seen from `p` (see
-    /// [`GuidingTree::splat`] for what the value is). `p` is first jittered
-    /// uniformly inside a box the size of its cell centred on it (on it
-    /// clamped onto the spatial tree's cube, for points outside; PPG's
-    /// stochastic box filter, +-1/2 cell per axis; the paper's code uses
-    /// +-1/4), which spreads each sample over the neighbouring cells in
-    /// proportion to their overlap with that box, so adjacent cells learn
-    /// similar cuts and no seams appear at cell borders. One `next_u64` of
-    /// `rng` per call. `&self`: any number of threads at once.
+    /// [`GuidingTree::splat`] for what the value is) into the cell(s) that
+    /// [`GltConfig::filter`] spreads `p` over: by default the cell holding
+    /// `p`. With [`SpatialFilter::StochasticBox`] `p` is first jittered
+    /// uniformly inside a box the size of its cell centred on it (PPG's
+    /// stochastic box, +-1/2 cell per axis; the paper's code uses +-1/4,
+    /// one `next_u64` of `rng` per call), which smooths cuts across cell
+    /// borders but also carries light through walls. `&self`: any number
+    /// of threads at once.
     pub fn splat<R: Rng + ?Sized>(
         &self,
         p: Vec3,
@@ -218,13 +227,11 @@ impl<'a, H: LightHierarchy + ?Sized> Glt<'a, H> {
         value: f32,
         rng: &mut R,
     ) -> SplatOutcome {
-        self.splat_filtered(p, light, value, SpatialFilter::StochasticBox, || {
-            jitter_u64(rng)
-        })
+        self.splat_filtered(p, light, value, self.config.filter, || jitter_u64(rng))
     }
 
-    /// Like [`Glt::splat`] without jitter: the estimate goes to the cell
-    /// holding `p` (deterministic; nearest-cell filtering).
+    /// Like [`Glt::splat`] with [`SpatialFilter::Nearest`] whatever the
+    /// configuration: the estimate goes to the cell holding `p`.
     pub fn splat_at(&self, p: Vec3, light: LightId, value: f32) -> SplatOutcome {
         self.splat_filtered(p, light, value, SpatialFilter::Nearest, || Vec3::ZERO)
     }
@@ -340,7 +347,7 @@ impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
         let mut outcome = SplatOutcome::Zero;
         cells.spread_from(p, at, filter, jitter, |cell, weight| {
             let cell = cells.data(cell);
-            match self.splat(cell.as_ref(), light, value * weight) {
+            match self.splat_weighted_from(cell.as_ref(), p, weight, light, value * weight) {
                 SplatOutcome::Dropped => outcome = SplatOutcome::Dropped,
                 o => {
                     accepted(cell);

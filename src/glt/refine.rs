@@ -1,10 +1,12 @@
 //! Rebuilding a cut from what it collected: split where a slot's share is
 //! above `sigma`, end (merge) where it is not.
 
-use super::config::{CutConfig, SplitPrior};
+use super::config::{CutConfig, Modulation, SplitPrior};
 use super::cut::{GuidingCut, sum_count};
 use super::cut_node::{CutNode, Slot};
 use super::guiding_tree::GuidingTree;
+use crate::emitter::ShadingContext;
+use crate::light_sampler::Query;
 use crate::light_tree::LightHierarchy;
 use crate::math::Side;
 use alloc::vec;
@@ -57,9 +59,14 @@ impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
         }
         let rebuilt = total > 0.0 && total.is_finite();
         if rebuilt {
-            cut.nodes = rebuild(self.tree(), &cut.nodes, &sums, total, config);
+            let anchor = match config.modulation {
+                Modulation::None => None,
+                Modulation::Importance => cut.anchor().map(|a| Query::new(&ShadingContext::at(a))),
+            };
+            cut.nodes = rebuild(self.tree(), &cut.nodes, &sums, total, config, anchor);
         }
         cut.sums.reset(sum_count(cut.nodes.len()));
+        cut.anchor.clear();
         rebuilt
     }
 }
@@ -106,12 +113,44 @@ fn split_weight<H: LightHierarchy + ?Sized>(
     }
 }
 
+/// The importances of `children` at the anchor, with a floor of 1e-6 of
+/// their sum so a cluster that the bound calls dark there but that did
+/// collect splats keeps a finite factor; `None` when both are zero (or
+/// not finite).
+fn anchor_importances<H: LightHierarchy + ?Sized>(
+    tree: &H,
+    anchor: &Query,
+    children: [u32; 2],
+) -> Option<(f64, f64)> {
+    let [l, r] = children.map(|c| anchor.importance(&tree.node_bounds(c)));
+    let t = l + r;
+    (t > 0.0 && t.is_finite()).then(|| (l.max(1e-6 * t), r.max(1e-6 * t)))
+}
+
+/// The stored `p_left` from the two sides' weights: their ratio, or with an
+/// anchor ([`Modulation::Importance`]) the ratio of the learned factors
+/// `weight / importance at the anchor`.
+fn stored_p_left(weights: (f64, f64), importances: Option<(f64, f64)>) -> f32 {
+    let (wl, wr) = weights;
+    let (fl, fr) = match importances {
+        Some((il, ir)) => (wl / il, wr / ir),
+        None => (wl, wr),
+    };
+    let f = fl + fr;
+    if f > 0.0 && f.is_finite() {
+        (fl / f) as f32
+    } else {
+        (wl / (wl + wr)) as f32
+    }
+}
+
 fn rebuild<H: LightHierarchy + ?Sized>(
     tree: &H,
     old: &[CutNode],
     sums: &[f64],
     total: f64,
     config: &CutConfig,
+    anchor: Option<Query>,
 ) -> Vec<CutNode> {
     let Some(root) = tree.root() else {
         return Vec::new();
@@ -129,6 +168,9 @@ fn rebuild<H: LightHierarchy + ?Sized>(
     while let Some(t) = stack.pop() {
         let mut slot = Slot::End(t.light);
         if let Some(children) = tree.children(t.light).filter(|_| t.weight > threshold) {
+            let imp = anchor
+                .as_ref()
+                .and_then(|a| anchor_importances(tree, a, children));
             // Each side's weight and the old node that stands for it.
             let sides: [(f64, Option<u32>); 2] = match t.old.and_then(|i| old.get(i as usize)) {
                 Some(o) => {
@@ -139,14 +181,27 @@ fn rebuild<H: LightHierarchy + ?Sized>(
                     })
                 }
                 None => {
-                    let (wl, wr) = split_weight(tree, children, t.weight, config.split_prior);
+                    // A fresh split: with an anchor, in proportion to the
+                    // importance there (equal learned factors), else by the
+                    // split prior.
+                    let (wl, wr) = imp
+                        .and_then(|(il, ir)| {
+                            let (el, er) = (tree.energy(children[0]), tree.energy(children[1]));
+                            let il = if el > 0.0 { il } else { 0.0 };
+                            let ir = if er > 0.0 { ir } else { 0.0 };
+                            Some((t.weight * il / (il + ir), t.weight * ir / (il + ir)))
+                                .filter(|(a, b)| (a + b).is_finite() && a + b > 0.0)
+                        })
+                        .unwrap_or_else(|| {
+                            split_weight(tree, children, t.weight, config.split_prior)
+                        });
                     [(wl, None), (wr, None)]
                 }
             };
             let sum = sides[0].0 + sides[1].0;
             if sum > 0.0 {
                 let index = nodes.len() as u32;
-                let p_left = (sides[0].0 / sum) as f32;
+                let p_left = stored_p_left((sides[0].0, sides[1].0), imp);
                 nodes.push(CutNode::new(
                     p_left,
                     [Slot::End(children[0]), Slot::End(children[1])],

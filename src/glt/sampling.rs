@@ -24,13 +24,13 @@
 //! these two functions along the emitter's path, so the pmf `sample` returns
 //! equals [`GuidingTree::pmf_exact`] bit for bit, fallbacks included.
 
-use super::config::{BelowCut, CutConfig};
+use super::config::{BelowCut, CutConfig, Modulation};
 use super::cut::GuidingCut;
 use super::cut_node::CutNode;
 use super::guiding_tree::{GuidingTree, decode_split};
 use super::walk::WalkNode;
 use crate::emitter::ShadingContext;
-use crate::light_sampler::{LightId, LightSample, LightSampler};
+use crate::light_sampler::{LightId, LightSample, LightSampler, Query};
 use crate::light_tree::LightHierarchy;
 use crate::math::{Descent, Side, pmf_to_f32};
 
@@ -133,7 +133,13 @@ pub(crate) struct Rule<'a, 'b, H: LightHierarchy + ?Sized> {
     tree: &'a H,
     nodes: &'b [CutNode],
     below: BelowCut,
-    ctx: &'b ShadingContext,
+    /// Whether the cut's probabilities follow the importance at the
+    /// shading point ([`Modulation::Importance`]).
+    modulate: bool,
+    /// Whether the walk needs light-tree node ids (importance anywhere).
+    track_light: bool,
+    /// The shading point, prepared for importance evaluations.
+    query: Query,
     /// Whether the prior component has weight (else its product is not
     /// tracked and stays 1, multiplied by a zero weight).
     prior: bool,
@@ -150,12 +156,15 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
     ) -> Self {
         let config = guide.config();
         let mixture = Mixture::new(guide.has_energy(), cut, config);
+        let modulate = config.modulation == Modulation::Importance;
         Self {
             guide,
             tree: guide.tree(),
             nodes: &cut.nodes,
             below: config.below_cut,
-            ctx,
+            modulate,
+            track_light: modulate || config.below_cut == BelowCut::Importance,
+            query: Query::new(ctx),
             prior: mixture.prior > 0.0,
             mixture,
         }
@@ -183,18 +192,42 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
     /// the cut needs it (else a placeholder: only importance reads it).
     #[inline(always)]
     fn child_light(&self, light: u32, side: usize) -> u32 {
-        match self.below {
-            BelowCut::Energy => 0,
-            BelowCut::Importance => self.tree.children(light).map_or(u32::MAX, |c| c[side]),
+        if self.track_light {
+            self.tree.children(light).map_or(u32::MAX, |c| c[side])
+        } else {
+            0
         }
+    }
+
+    /// The importances of the two children of inner node `node` at the
+    /// shading point.
+    #[inline(always)]
+    fn child_importances(&self, node: u32) -> Option<(f64, f64)> {
+        let [l, r] = self.tree.children(node)?;
+        let imp = |n| self.query.importance(&self.tree.node_bounds(n));
+        Some((imp(l), imp(r)))
     }
 
     /// The importance probabilities of the children of inner node `node`.
     #[inline(always)]
     fn importance(&self, node: u32) -> Option<(f64, f64)> {
-        let [l, r] = self.tree.children(node)?;
-        let imp = |n| crate::light_sampler::importance(self.ctx, &self.tree.node_bounds(n)) as f64;
-        Descent::probabilities(imp(l), imp(r))
+        let (l, r) = self.child_importances(node)?;
+        Descent::probabilities(l, r)
+    }
+
+    /// The probabilities of a cut node standing for light node `light`:
+    /// its learned ones, or with [`Modulation::Importance`] its learned
+    /// factor ratio times the children's importance at the shading point
+    /// (the learned ones where both importances vanish).
+    #[inline(always)]
+    fn cut_probabilities(&self, node: &CutNode, light: u32) -> (f64, f64) {
+        let learned = node.probabilities();
+        if !self.modulate {
+            return learned;
+        }
+        self.child_importances(light)
+            .and_then(|(il, ir)| Descent::probabilities(learned.0 * il, learned.1 * ir))
+            .unwrap_or(learned)
     }
 
     /// The probabilities of both components at the inner node `at`, whose
@@ -203,7 +236,7 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
     fn step(&self, at: Cursor, split: f32) -> Step {
         match at.cut {
             Some(node) => Step {
-                cut: Some(node.probabilities()),
+                cut: Some(self.cut_probabilities(&node, at.light)),
                 prior: if self.prior {
                     decode_split(split)
                 } else {

@@ -1,9 +1,11 @@
 //! Recording direct-light estimates into a cut's accumulating copy.
 
+use super::config::Modulation;
 use super::cut::GuidingCut;
 use super::guiding_tree::GuidingTree;
 use crate::light_sampler::LightId;
 use crate::light_tree::LightHierarchy;
+use glam::Vec3;
 
 /// What became of one splat.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -60,6 +62,10 @@ impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
     /// on the emitter's path that ends the cut (or to the environment's
     /// sum). Takes `&self`: any number of threads may splat at once, no
     /// update is lost.
+    ///
+    /// The splat carries no position, so a cut trained only through this
+    /// call has no anchor for [`Modulation::Importance`]; use
+    /// [`GuidingTree::splat_from`] there.
     pub fn splat(&self, cut: &GuidingCut, light: LightId, value: f32) -> SplatOutcome {
         if !(value >= 0.0 && value.is_finite()) {
             return SplatOutcome::Dropped;
@@ -84,5 +90,39 @@ impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
         } else {
             SplatOutcome::Dropped
         }
+    }
+
+    /// [`GuidingTree::splat`] of an estimate made at the shading point
+    /// `from`: with [`Modulation::Importance`] a recorded splat also adds
+    /// `from` to the cut's anchor (the mean position its learned weights
+    /// come from). The cells of [`crate::glt::Glt`] and of the combined
+    /// field splat this way.
+    pub fn splat_from(
+        &self,
+        cut: &GuidingCut,
+        from: Vec3,
+        light: LightId,
+        value: f32,
+    ) -> SplatOutcome {
+        self.splat_weighted_from(cut, from, 1.0, light, value)
+    }
+
+    /// [`GuidingTree::splat_from`] for the share `weight` of a splat that
+    /// a spatial filter spread over several cells (`value` is already
+    /// scaled; the anchor takes `from` with this weight).
+    #[inline]
+    pub(crate) fn splat_weighted_from(
+        &self,
+        cut: &GuidingCut,
+        from: Vec3,
+        weight: f32,
+        light: LightId,
+        value: f32,
+    ) -> SplatOutcome {
+        let outcome = self.splat(cut, light, value);
+        if outcome == SplatOutcome::Recorded && self.config().modulation != Modulation::None {
+            cut.record_position(from, weight);
+        }
+        outcome
     }
 }

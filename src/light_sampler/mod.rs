@@ -24,6 +24,7 @@ mod tree_walk;
 mod uniform;
 
 pub use environment::WithEnvironment;
+pub(crate) use importance::Query;
 pub use importance::importance;
 pub use power::PowerSampler;
 pub use tree_energy::EnergyTreeSampler;
