@@ -6,7 +6,7 @@
 
 use glam::Vec3;
 use guiding::glt::{
-    BelowCut, CutConfig, CutNode, GuidingCut, GuidingTree, Modulation, Slot, SplatOutcome,
+    BelowCut, CutConfig, CutNode, GuidingCut, GuidingTree, Modulation, Prior, Slot, SplatOutcome,
     SplitPrior,
 };
 use guiding::light_tree::{BuildHeuristic, EmitterPath, NodeBounds};
@@ -228,9 +228,23 @@ fn config_strategy() -> impl Strategy<Value = CutConfig> {
         any::<bool>(),
         prop_oneof![Just(0u32), Just(1), Just(64)],
         any::<bool>(),
+        prop_oneof![Just(0.0), Just(0.5), Just(1.0)],
+        any::<bool>(),
+        prop_oneof![Just(f32::INFINITY), Just(0.0), Just(1.0), Just(4.0)],
     )
         .prop_map(
-            |(sigma, alpha, variant, environment, exact, min_splats, modulate)| {
+            |(
+                sigma,
+                alpha,
+                variant,
+                environment,
+                exact,
+                min_splats,
+                modulate,
+                carry_over,
+                prior_imp,
+                near_field,
+            )| {
                 let (below_cut, split_prior) = ALL_CONFIGS[variant];
                 CutConfig {
                     sigma,
@@ -249,6 +263,13 @@ fn config_strategy() -> impl Strategy<Value = CutConfig> {
                         Accumulation::Fast
                     },
                     min_splats,
+                    carry_over,
+                    prior: if prior_imp {
+                        Prior::Importance
+                    } else {
+                        Prior::Energy
+                    },
+                    near_field,
                 }
             },
         )
@@ -1194,7 +1215,10 @@ fn modulation_reproduces_the_learned_cut_at_the_anchor_and_follows_importance() 
             plain.pmf_exact(&a, &at, LightId::Emitter(i)),
             modulated.pmf_exact(&b, &at, LightId::Emitter(i)),
         );
-        assert!((p - q).abs() <= 1e-5 * p, "light {i} at the anchor: {p} vs {q}");
+        assert!(
+            (p - q).abs() <= 1e-5 * p,
+            "light {i} at the anchor: {p} vs {q}"
+        );
     }
     // Near the row's start the first lights matter far more than at the
     // anchor; the plain cut cannot know.

@@ -1,7 +1,7 @@
 //! A GLT configuration to measure, from a `key=value` list.
 
 use crate::methods::GuideParams;
-use guiding::glt::{BelowCut, Modulation};
+use guiding::glt::{BelowCut, Modulation, Prior};
 use guiding::spatial::SpatialFilter;
 
 /// One GLT configuration and how long it trains.
@@ -27,7 +27,8 @@ impl GltVariant {
 
     /// Parses `spec`: space-separated `key=value` (sigma, alpha,
     /// below=energy|importance, modulation=none|importance,
-    /// splat=radiance|contribution, filter=nearest|jitter, min-splats,
+    /// splat=radiance|contribution, filter=nearest|jitter, carry,
+    /// prior=energy|importance, near, min-splats,
     /// threshold, train-spp) applied
     /// to the defaults.
     pub fn parse(spec: &str, train_spp: u64) -> Result<Self, String> {
@@ -41,6 +42,15 @@ impl GltVariant {
                 "sigma" => v.params.sigma = num()?,
                 "alpha" => v.params.alpha = num()?,
                 "threshold" => v.params.glt_spatial_threshold = num()?,
+                "carry" => v.params.carry_over = num()?,
+                "near" => v.params.near_field = num()? as f32,
+                "prior" => {
+                    v.params.prior = match val {
+                        "energy" => Prior::Energy,
+                        "importance" => Prior::Importance,
+                        _ => return Err(format!("`{kv}`: energy or importance")),
+                    }
+                }
                 "min-splats" => v.params.min_splats = num()? as u32,
                 "train-spp" => v.train_spp = num()? as u64,
                 "below" => {

@@ -57,6 +57,24 @@ pub enum Modulation {
     Importance,
 }
 
+/// The distribution of the defensive mixture's prior component (weight
+/// [`CutConfig::alpha`]), which keeps every emitter that can contribute at
+/// a non-zero pmf whatever the cut learned.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Prior {
+    /// Tree-by-energy from the light tree's root: power sampling, the same
+    /// at every shading point.
+    #[default]
+    Energy,
+    /// Tree-by-importance from the root (the Estevez-Kulla / pbrt-v4 rule
+    /// of [`crate::ImportanceTreeSampler`], energy where both children's
+    /// importance vanishes). The importance bound is conservative, so an
+    /// emitter that can reach the point keeps a non-zero pmf. With
+    /// [`Modulation::Importance`] and [`BelowCut::Importance`] the walk
+    /// evaluates these importances anyway, so the better prior is free.
+    Importance,
+}
+
 /// How a slot that is split for the first time shares its learned weight
 /// between its two new children (they have no statistics of their own yet).
 ///
@@ -115,6 +133,9 @@ pub struct CutConfig {
     /// Whether the cut's probabilities vary inside a cell. Default
     /// [`Modulation::None`].
     pub modulation: Modulation,
+    /// The prior component of the defensive mixture. Default
+    /// [`Prior::Energy`].
+    pub prior: Prior,
     /// How a newly split slot's weight is shared. Default
     /// [`SplitPrior::Half`].
     pub split_prior: SplitPrior,
@@ -138,6 +159,28 @@ pub struct CutConfig {
     /// `0` gives the paper's rule (rebuild from any data). Default 64,
     /// measured (docs/results.md, "The cut's data floor").
     pub min_splats: u32,
+    /// How much of what a cut learned the next iteration starts from: after
+    /// a rebuild, the sum of each slot that ends the new cut starts at
+    /// `carry_over` times the weight the rebuild gave it (the environment's
+    /// and the anchor's sums likewise), instead of zero. Light splats are
+    /// unbiased estimates whatever distribution drew them, so sums of
+    /// several iterations add up; carrying them shrinks each rebuild toward
+    /// the previous cut where a slot has few new splats, instead of
+    /// forgetting all but the last iteration's data. `0` gives the paper's
+    /// rule (every iteration learns from its own splats only); `1` weighs
+    /// all iterations' splats alike.
+    pub carry_over: f64,
+    /// Where importance stops being evaluated. A light-tree node whose
+    /// distance from the shading point exceeds `near_field` times its
+    /// bounding-sphere radius lies in the far field: there the inverse
+    /// square law hardly differs between its lights, and every
+    /// importance-based rule ([`Modulation::Importance`],
+    /// [`BelowCut::Importance`], [`Prior::Importance`]) continues below it
+    /// by energy instead, saving two node decodes and importance
+    /// evaluations per level. `f32::INFINITY` evaluates importance down to
+    /// the leaves. Any value keeps the pmf exact (sampling and pmf apply
+    /// the same test).
+    pub near_field: f32,
 }
 
 impl Default for CutConfig {
@@ -147,15 +190,27 @@ impl Default for CutConfig {
             alpha: 0.2,
             below_cut: BelowCut::Energy,
             modulation: Modulation::None,
+            prior: Prior::Energy,
             split_prior: SplitPrior::Half,
             environment: None,
             accumulation: Accumulation::Fast,
             min_splats: 64,
+            carry_over: 0.0,
+            near_field: f32::INFINITY,
         }
     }
 }
 
 impl CutConfig {
+    /// Whether any rule evaluates the importance of light-tree nodes
+    /// ([`Modulation::Importance`], [`BelowCut::Importance`],
+    /// [`Prior::Importance`]).
+    pub fn uses_importance(&self) -> bool {
+        self.modulation == Modulation::Importance
+            || self.below_cut == BelowCut::Importance
+            || self.prior == Prior::Importance
+    }
+
     /// The configuration with every number clamped into its range (NaN
     /// replaced by the default). The cut code only ever uses this form.
     pub fn sanitized(&self) -> Self {
@@ -170,6 +225,12 @@ impl CutConfig {
         Self {
             sigma: unit(self.sigma, d.sigma),
             alpha: unit(self.alpha, d.alpha),
+            carry_over: unit(self.carry_over, d.carry_over),
+            near_field: if self.near_field.is_nan() {
+                d.near_field
+            } else {
+                self.near_field.max(0.0)
+            },
             environment: self.environment.map(|q| unit(q, 0.0)),
             ..*self
         }

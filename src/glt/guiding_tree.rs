@@ -4,6 +4,7 @@
 use super::config::CutConfig;
 use super::cut::GuidingCut;
 use super::walk::WalkTable;
+use crate::light_sampler::ImportanceTable;
 use crate::light_tree::LightHierarchy;
 use crate::math::Descent;
 use alloc::vec::Vec;
@@ -30,6 +31,9 @@ pub struct GuidingTree<'a, H: LightHierarchy + ?Sized> {
     tree: &'a H,
     split: Vec<f32>,
     walk: WalkTable,
+    /// Every node decoded for the importance-based rules; built only when
+    /// the configuration uses one.
+    importance: Option<ImportanceTable>,
     config: CutConfig,
     has_energy: bool,
 }
@@ -81,11 +85,14 @@ impl<'a, H: LightHierarchy + ?Sized> GuidingTree<'a, H> {
             })
             .collect();
         let walk = WalkTable::new(tree, |n| split.get(n as usize).copied().unwrap_or(f32::NAN));
+        let config = config.sanitized();
+        let importance = config.uses_importance().then(|| ImportanceTable::new(tree));
         Self {
             tree,
             split,
             walk,
-            config: config.sanitized(),
+            importance,
+            config,
             has_energy: tree.root().is_some_and(|r| tree.energy(r) > 0.0),
         }
     }
@@ -111,7 +118,9 @@ impl<'a, H: LightHierarchy + ?Sized> GuidingTree<'a, H> {
     /// Heap bytes of the split table and the walk table (12 per
     /// light-tree node).
     pub fn bytes(&self) -> usize {
-        self.split.len() * core::mem::size_of::<f32>() + self.walk.bytes()
+        self.split.len() * core::mem::size_of::<f32>()
+            + self.walk.bytes()
+            + self.importance.as_ref().map_or(0, ImportanceTable::bytes)
     }
 
     /// The raw split-table entry of `node` (NaN for leaves and indices out
@@ -125,6 +134,13 @@ impl<'a, H: LightHierarchy + ?Sized> GuidingTree<'a, H> {
     #[inline(always)]
     pub(crate) fn walk(&self) -> &WalkTable {
         &self.walk
+    }
+
+    /// The decoded nodes of the importance-based rules, when the
+    /// configuration uses one.
+    #[inline(always)]
+    pub(crate) fn importance_table(&self) -> Option<&ImportanceTable> {
+        self.importance.as_ref()
     }
 
     /// The prior (energy) probabilities of the children of inner node

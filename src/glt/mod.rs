@@ -38,7 +38,7 @@ mod sampling;
 mod splat;
 mod walk;
 
-pub use config::{BelowCut, CutConfig, Modulation, SplitPrior};
+pub use config::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
 pub use cut::{CutError, CutMemory, GuidingCut};
 pub use cut_node::{CutNode, Slot};
 pub use field::{Glt, GltCell, GltConfig, GltMemory};

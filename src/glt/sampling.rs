@@ -9,10 +9,16 @@
 //!
 //! where `f` is the cell's learned environment fraction, `q` the user's
 //! prior probability of the environment (both 0 without one), `P_prior` the
-//! tree-by-energy pmf from the light tree's root, and `P_cut` the product of
-//! the cut's learned `p_left`/`1 - p_left` down to the slot that ends the cut,
-//! then of the light tree's energy ratios (the paper) or importance ratios
-//! ([`BelowCut::Importance`]) below it.
+//! prior's pmf from the light tree's root (tree-by-energy, or
+//! tree-by-importance at the shading point with [`Prior::Importance`]), and
+//! `P_cut` the product of the cut's probabilities down to the slot that ends
+//! the cut, then of the light tree's energy ratios (the paper) or importance
+//! ratios ([`BelowCut::Importance`]) below it. Inside the cut a node's
+//! probabilities are its learned `p_left` (the paper: one distribution per
+//! cell) or, with [`Modulation::Importance`], its learned factor ratio `r`
+//! times the children's importance `I` at the shading point:
+//! `r I_l / (r I_l + (1 - r) I_r)`, so the distribution follows the point
+//! inside the cell.
 //!
 //! One uniform number drives everything through one [`Descent`]: first
 //! environment or emitters, then which mixture component, then the walk
@@ -24,13 +30,13 @@
 //! these two functions along the emitter's path, so the pmf `sample` returns
 //! equals [`GuidingTree::pmf_exact`] bit for bit, fallbacks included.
 
-use super::config::{BelowCut, CutConfig, Modulation};
+use super::config::{BelowCut, CutConfig, Modulation, Prior};
 use super::cut::GuidingCut;
 use super::cut_node::CutNode;
 use super::guiding_tree::{GuidingTree, decode_split};
 use super::walk::WalkNode;
 use crate::emitter::ShadingContext;
-use crate::light_sampler::{LightId, LightSample, LightSampler, Query};
+use crate::light_sampler::{FastQuery, ImportanceTable, LightId, LightSample, LightSampler, Query};
 use crate::light_tree::LightHierarchy;
 use crate::math::{Descent, Side, pmf_to_f32};
 
@@ -95,6 +101,10 @@ struct Cursor {
     node: WalkNode,
     light: u32,
     cut: Option<CutNode>,
+    /// The node lies in the far field of the shading point (see
+    /// [`CutConfig::near_field`]): importance is no longer evaluated at or
+    /// below it.
+    far: bool,
 }
 
 /// The probabilities at one inner light-tree node.
@@ -108,6 +118,8 @@ struct Step {
     prior: Option<(f64, f64)>,
     /// The cut node on each side, `None` where the cut ends.
     next: [Option<u32>; 2],
+    /// Whether each child lies in the far field.
+    far: [bool; 2],
 }
 
 /// Running products of the two components along a walk.
@@ -136,10 +148,20 @@ pub(crate) struct Rule<'a, 'b, H: LightHierarchy + ?Sized> {
     /// Whether the cut's probabilities follow the importance at the
     /// shading point ([`Modulation::Importance`]).
     modulate: bool,
+    /// Whether the prior component follows the importance ([`Prior`]).
+    prior_importance: bool,
     /// Whether the walk needs light-tree node ids (importance anywhere).
     track_light: bool,
     /// The shading point, prepared for importance evaluations.
     query: Query,
+    /// The decoded nodes, when the configuration uses importance.
+    table: Option<&'b ImportanceTable>,
+    /// The shading point, prepared for the decoded nodes.
+    fast: FastQuery,
+    /// The shading point.
+    position: glam::Vec3,
+    /// `near_field^2` of the configuration.
+    near_field2: f32,
     /// Whether the prior component has weight (else its product is not
     /// tracked and stays 1, multiplied by a zero weight).
     prior: bool,
@@ -157,14 +179,20 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
         let config = guide.config();
         let mixture = Mixture::new(guide.has_energy(), cut, config);
         let modulate = config.modulation == Modulation::Importance;
+        let prior_importance = config.prior == Prior::Importance;
         Self {
             guide,
             tree: guide.tree(),
             nodes: &cut.nodes,
             below: config.below_cut,
             modulate,
-            track_light: modulate || config.below_cut == BelowCut::Importance,
+            prior_importance,
+            track_light: modulate || prior_importance || config.below_cut == BelowCut::Importance,
             query: Query::new(ctx),
+            table: guide.importance_table(),
+            fast: FastQuery::new(ctx),
+            position: ctx.position,
+            near_field2: config.near_field * config.near_field,
             prior: mixture.prior > 0.0,
             mixture,
         }
@@ -176,6 +204,7 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
             node: self.guide.walk().root()?,
             light: self.tree.root()?,
             cut: self.nodes.first().copied(),
+            far: false,
         })
     }
 
@@ -200,64 +229,95 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
     }
 
     /// The importances of the two children of inner node `node` at the
-    /// shading point.
+    /// shading point, and whether each lies in the far field (its distance
+    /// from the point above `near_field` times its bounding radius).
     #[inline(always)]
-    fn child_importances(&self, node: u32) -> Option<(f64, f64)> {
+    fn child_importances(&self, node: u32) -> Option<((f64, f64), [bool; 2])> {
         let [l, r] = self.tree.children(node)?;
-        let imp = |n| self.query.importance(&self.tree.node_bounds(n));
-        Some((imp(l), imp(r)))
-    }
-
-    /// The importance probabilities of the children of inner node `node`.
-    #[inline(always)]
-    fn importance(&self, node: u32) -> Option<(f64, f64)> {
-        let (l, r) = self.child_importances(node)?;
-        Descent::probabilities(l, r)
-    }
-
-    /// The probabilities of a cut node standing for light node `light`:
-    /// its learned ones, or with [`Modulation::Importance`] its learned
-    /// factor ratio times the children's importance at the shading point
-    /// (the learned ones where both importances vanish).
-    #[inline(always)]
-    fn cut_probabilities(&self, node: &CutNode, light: u32) -> (f64, f64) {
-        let learned = node.probabilities();
-        if !self.modulate {
-            return learned;
+        let far = |(c, r2): (glam::Vec3, f32)| {
+            (self.position - c).length_squared() > self.near_field2 * r2
+        };
+        match self.table {
+            Some(t) => Some((
+                (t.importance(&self.fast, l), t.importance(&self.fast, r)),
+                [far(t.sphere(l)), far(t.sphere(r))],
+            )),
+            None => {
+                let (bl, br) = (self.tree.node_bounds(l), self.tree.node_bounds(r));
+                let sphere = |b: &crate::light_tree::NodeBounds| {
+                    let (c, d) = (b.bounds.center(), b.bounds.max - b.bounds.min);
+                    (c, 0.25 * d.length_squared())
+                };
+                Some((
+                    (self.query.importance(&bl), self.query.importance(&br)),
+                    [far(sphere(&bl)), far(sphere(&br))],
+                ))
+            }
         }
-        self.child_importances(light)
-            .and_then(|(il, ir)| Descent::probabilities(learned.0 * il, learned.1 * ir))
-            .unwrap_or(learned)
     }
 
     /// The probabilities of both components at the inner node `at`, whose
     /// split-table entry is `split`.
+    ///
+    /// - Inside the cut the learned component takes the cut node's
+    ///   `p_left`, or with [`Modulation::Importance`] the learned factor
+    ///   ratio times the children's importance at the shading point (the
+    ///   learned `p_left` where both importances vanish).
+    /// - Below the cut it takes the [`BelowCut`] rule (energy where both
+    ///   importances vanish, so the component stays a distribution).
+    /// - The prior component takes the [`Prior`] rule (likewise).
+    ///
+    /// The children's importances are evaluated at most once per node.
     #[inline(always)]
     fn step(&self, at: Cursor, split: f32) -> Step {
+        let energy = decode_split(split);
+        let needs_importance = !at.far
+            && (self.prior_importance
+                || match at.cut {
+                    Some(_) => self.modulate,
+                    None => self.below == BelowCut::Importance,
+                });
+        let (imp, far) = match needs_importance
+            .then(|| self.child_importances(at.light))
+            .flatten()
+        {
+            Some((imp, far)) => (Some(imp), far),
+            None => (None, [at.far; 2]),
+        };
+        let by_importance = || {
+            imp.and_then(|(l, r)| Descent::probabilities(l, r))
+                .or(energy)
+        };
+        let prior = match (self.prior, self.prior_importance) {
+            (false, _) => None,
+            (true, false) => energy,
+            (true, true) => by_importance(),
+        };
         match at.cut {
-            Some(node) => Step {
-                cut: Some(self.cut_probabilities(&node, at.light)),
-                prior: if self.prior {
-                    decode_split(split)
-                } else {
-                    None
-                },
-                next: [node.child(Side::Left), node.child(Side::Right)],
-            },
-            None => {
-                let e = decode_split(split);
-                let cut = match self.below {
-                    BelowCut::Energy => e,
-                    // Both importances zero: fall back to energy, so the
-                    // component stays a distribution.
-                    BelowCut::Importance => self.importance(at.light).or(e),
+            Some(node) => {
+                let learned = node.probabilities();
+                let cut = match imp.filter(|_| self.modulate) {
+                    Some((il, ir)) => {
+                        Descent::probabilities(learned.0 * il, learned.1 * ir).unwrap_or(learned)
+                    }
+                    None => learned,
                 };
                 Step {
-                    cut,
-                    prior: e,
-                    next: [None, None],
+                    cut: Some(cut),
+                    prior,
+                    next: [node.child(Side::Left), node.child(Side::Right)],
+                    far,
                 }
             }
+            None => Step {
+                cut: match self.below {
+                    BelowCut::Energy => energy,
+                    BelowCut::Importance => by_importance(),
+                },
+                prior,
+                next: [None, None],
+                far,
+            },
         }
     }
 
@@ -316,6 +376,7 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
                 node: pair.0[k],
                 light: self.child_light(at.light, k),
                 cut: cuts[k],
+                far: step.far[k],
             };
             children = at.node.children().map(|_| grand[k]);
         }
@@ -350,6 +411,7 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
                 return 0.0;
             }
             at.cut = step.next[side.index()].and_then(|i| self.nodes.get(i as usize).copied());
+            at.far = step.far[side.index()];
         }
         self.mixture.emitter_pmf(p)
     }
@@ -373,9 +435,10 @@ impl<'a, H: LightHierarchy + ?Sized> GuidingTree<'a, H> {
     /// ```
     ///
     /// (`f` the cell's learned environment fraction, `q` the configured
-    /// prior one, `P_prior` tree-by-energy, `P_cut` the cut's learned
-    /// probabilities down to the cut, then the [`BelowCut`] rule; the full
-    /// description is at the top of `src/glt/sampling.rs`). `None` when
+    /// prior one, `P_prior` the [`Prior`] rule from the root, `P_cut` the
+    /// cut's learned probabilities, [`Modulation`] applied, down to the cut,
+    /// then the [`BelowCut`] rule; the full description is at the top of
+    /// `src/glt/sampling.rs`). `None` when
     /// nothing can be chosen or the pmf rounds to zero in `f32`.
     #[inline]
     pub fn sample(&self, cut: &GuidingCut, ctx: &ShadingContext, u: f32) -> Option<LightSample> {

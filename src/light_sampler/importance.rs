@@ -16,7 +16,7 @@ const MIN_DISTANCE2: f64 = 1e-200;
 /// 90 degrees from every normal (`cos(theta') <= 0` but within `theta_e`,
 /// e.g. a wide spot light's back). pbrt-v4 gives such points zero importance,
 /// which would never sample lights that do reach them.
-const BACK_FACTOR: f64 = 1e-3;
+pub(crate) const BACK_FACTOR: f64 = 1e-3;
 
 /// The importance of the lights bounded by `node` at the shading point
 /// `ctx`: power x a conservative cosine of the emission angle / clamped

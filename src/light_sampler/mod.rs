@@ -17,6 +17,7 @@
 
 mod environment;
 mod importance;
+mod importance_table;
 mod power;
 mod tree_energy;
 mod tree_importance;
@@ -26,6 +27,7 @@ mod uniform;
 pub use environment::WithEnvironment;
 pub(crate) use importance::Query;
 pub use importance::importance;
+pub(crate) use importance_table::{FastQuery, ImportanceTable};
 pub use power::PowerSampler;
 pub use tree_energy::EnergyTreeSampler;
 pub use tree_importance::ImportanceTreeSampler;
