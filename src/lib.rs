@@ -56,6 +56,7 @@
 //! | cut refinement (split / merge by sigma, `min_splats`) | `src/glt/refine.rs` |
 //! | light-tree build heuristics | `src/light_tree/build.rs` |
 //! | the importance of a light cluster | `src/light_sampler/importance.rs` |
+//! | the same, from decoded nodes in `f32` (the GLT's importance rules) | `src/light_sampler/importance_table.rs` |
 //! | the one-number descent | `src/math/descent.rs` |
 //! | quadtree sampling and pdf | `src/quadtree/query.rs` |
 //!

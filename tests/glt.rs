@@ -228,23 +228,10 @@ fn config_strategy() -> impl Strategy<Value = CutConfig> {
         any::<bool>(),
         prop_oneof![Just(0u32), Just(1), Just(64)],
         any::<bool>(),
-        prop_oneof![Just(0.0), Just(0.5), Just(1.0)],
         any::<bool>(),
-        prop_oneof![Just(f32::INFINITY), Just(0.0), Just(1.0), Just(4.0)],
     )
         .prop_map(
-            |(
-                sigma,
-                alpha,
-                variant,
-                environment,
-                exact,
-                min_splats,
-                modulate,
-                carry_over,
-                prior_imp,
-                near_field,
-            )| {
+            |(sigma, alpha, variant, environment, exact, min_splats, modulate, prior_imp)| {
                 let (below_cut, split_prior) = ALL_CONFIGS[variant];
                 CutConfig {
                     sigma,
@@ -263,13 +250,11 @@ fn config_strategy() -> impl Strategy<Value = CutConfig> {
                         Accumulation::Fast
                     },
                     min_splats,
-                    carry_over,
                     prior: if prior_imp {
                         Prior::Importance
                     } else {
                         Prior::Energy
                     },
-                    near_field,
                 }
             },
         )

@@ -27,8 +27,8 @@ impl GltVariant {
 
     /// Parses `spec`: space-separated `key=value` (sigma, alpha,
     /// below=energy|importance, modulation=none|importance,
-    /// splat=radiance|contribution, filter=nearest|jitter, carry,
-    /// prior=energy|importance, near, min-splats,
+    /// splat=radiance|contribution, filter=nearest|jitter,
+    /// prior=energy|importance, min-splats,
     /// threshold, train-spp) applied
     /// to the defaults.
     pub fn parse(spec: &str, train_spp: u64) -> Result<Self, String> {
@@ -42,8 +42,6 @@ impl GltVariant {
                 "sigma" => v.params.sigma = num()?,
                 "alpha" => v.params.alpha = num()?,
                 "threshold" => v.params.glt_spatial_threshold = num()?,
-                "carry" => v.params.carry_over = num()?,
-                "near" => v.params.near_field = num()? as f32,
                 "prior" => {
                     v.params.prior = match val {
                         "energy" => Prior::Energy,

@@ -68,17 +68,9 @@ pub struct Args {
     /// shading point's own cell.
     #[arg(long)]
     pub glt_jitter: bool,
-    /// How much of a cut's learned weights the next iteration starts from
-    /// (`guiding::glt::CutConfig::carry_over`; 0 = the paper's rule).
-    #[arg(long, default_value_t = guiding::glt::CutConfig::default().carry_over)]
-    pub carry_over: f64,
     /// The GLT's defensive prior: `energy` or `importance`.
     #[arg(long, default_value = "energy", value_parser = parse_prior)]
     pub prior: Prior,
-    /// Distance / radius beyond which the GLT stops evaluating importance
-    /// (`guiding::glt::CutConfig::near_field`; `inf` for never).
-    #[arg(long, default_value_t = guiding::glt::CutConfig::default().near_field)]
-    pub near_field: f32,
     /// Worker threads [default: all cores].
     #[arg(long)]
     pub threads: Option<usize>,

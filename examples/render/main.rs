@@ -126,9 +126,7 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
             } else {
                 SpatialFilter::Nearest
             },
-            carry_over: args.carry_over,
             prior: args.prior,
-            near_field: args.near_field,
         },
         seed: args.seed,
         progress: !args.quiet,

@@ -108,12 +108,8 @@ pub struct GuideParams {
     pub contribution_splats: bool,
     /// The spatial filter of the GLT's light splats (`pt-glt`).
     pub glt_filter: SpatialFilter,
-    /// How much of a cut's learned weights the next iteration starts from.
-    pub carry_over: f64,
     /// The GLT's defensive prior.
     pub prior: Prior,
-    /// Distance / radius beyond which the GLT stops evaluating importance.
-    pub near_field: f32,
 }
 
 impl Default for GuideParams {
@@ -131,9 +127,7 @@ impl Default for GuideParams {
             modulation: cut.modulation,
             contribution_splats: false,
             glt_filter: GltConfig::default().filter,
-            carry_over: cut.carry_over,
             prior: cut.prior,
-            near_field: cut.near_field,
         }
     }
 }
@@ -170,9 +164,7 @@ fn cut_config(scene: &Scene, params: &GuideParams) -> CutConfig {
         min_splats: params.min_splats,
         alpha: params.alpha,
         modulation: params.modulation,
-        carry_over: params.carry_over,
         prior: params.prior,
-        near_field: params.near_field,
         environment: scene
             .environment
             .map(|_| f64::from(scene.environment_probability)),

@@ -86,7 +86,9 @@ impl<'a, H: LightHierarchy + ?Sized> GuidingTree<'a, H> {
             .collect();
         let walk = WalkTable::new(tree, |n| split.get(n as usize).copied().unwrap_or(f32::NAN));
         let config = config.sanitized();
-        let importance = config.uses_importance().then(|| ImportanceTable::new(tree));
+        let importance = config
+            .uses_importance()
+            .then(|| ImportanceTable::new(tree, WalkTable::pair_nodes(tree).into_iter()));
         Self {
             tree,
             split,

@@ -58,36 +58,15 @@ impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
             cut.env_fraction = (env / (env + total)) as f32;
         }
         let rebuilt = total > 0.0 && total.is_finite();
-        let mut carried = Vec::new();
         if rebuilt {
             let anchor = match config.modulation {
                 Modulation::None => None,
                 Modulation::Importance => cut.anchor().map(|a| Query::new(&ShadingContext::at(a))),
             };
-            let (nodes, ends) = rebuild(self.tree(), &cut.nodes, &sums, total, config, anchor);
-            cut.nodes = nodes;
-            carried = ends;
+            cut.nodes = rebuild(self.tree(), &cut.nodes, &sums, total, config, anchor);
         }
         cut.sums.reset(sum_count(cut.nodes.len()));
-        let keep = config.carry_over;
-        if keep > 0.0 {
-            // The next iteration's sums start from what was learned: each
-            // slot that ends the new cut from its weight, the environment
-            // from its sum, the anchor from its sums, all scaled by
-            // `carry_over`.
-            let scale = |w: f64| (w * keep) as f32;
-            for (i, &w) in carried.iter().enumerate() {
-                cut.sums.add(i, scale(w));
-            }
-            cut.sums.add(sum_count(cut.nodes.len()) - 1, scale(env));
-            let anchor: Vec<f64> = (0..cut.anchor.len()).map(|i| cut.anchor.get(i)).collect();
-            cut.anchor.clear();
-            for (i, a) in anchor.into_iter().enumerate() {
-                cut.anchor.add(i, scale(a));
-            }
-        } else {
-            cut.anchor.clear();
-        }
+        cut.anchor.clear();
         rebuilt
     }
 }
@@ -172,13 +151,10 @@ fn rebuild<H: LightHierarchy + ?Sized>(
     total: f64,
     config: &CutConfig,
     anchor: Option<Query>,
-) -> (Vec<CutNode>, Vec<f64>) {
+) -> Vec<CutNode> {
     let Some(root) = tree.root() else {
-        return (Vec::new(), Vec::new());
+        return Vec::new();
     };
-    // The weight of every slot that ends the new cut, at its sum's index
-    // (`2 node + side`; the root cluster's at 0 for an empty cut).
-    let mut ends: Vec<f64> = Vec::new();
     let threshold = config.sigma * total;
     let old_weights = subtree_weights(old, sums);
     let mut nodes: Vec<CutNode> = Vec::new();
@@ -245,20 +221,9 @@ fn rebuild<H: LightHierarchy + ?Sized>(
                 slot = Slot::Child(index);
             }
         }
-        let end = match slot {
-            Slot::End(_) if t.parent == ROOT => Some(0),
-            Slot::End(_) => Some(2 * t.parent as usize + t.side.index()),
-            Slot::Child(_) => None,
-        };
-        if let Some(i) = end {
-            if ends.len() <= i {
-                ends.resize(i + 1, 0.0);
-            }
-            ends[i] = t.weight;
-        }
         if t.parent != ROOT {
             nodes[t.parent as usize].set_slot(t.side, slot);
         }
     }
-    (nodes, ends)
+    nodes
 }

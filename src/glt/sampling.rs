@@ -101,10 +101,6 @@ struct Cursor {
     node: WalkNode,
     light: u32,
     cut: Option<CutNode>,
-    /// The node lies in the far field of the shading point (see
-    /// [`CutConfig::near_field`]): importance is no longer evaluated at or
-    /// below it.
-    far: bool,
 }
 
 /// The probabilities at one inner light-tree node.
@@ -118,8 +114,6 @@ struct Step {
     prior: Option<(f64, f64)>,
     /// The cut node on each side, `None` where the cut ends.
     next: [Option<u32>; 2],
-    /// Whether each child lies in the far field.
-    far: [bool; 2],
 }
 
 /// Running products of the two components along a walk.
@@ -158,10 +152,6 @@ pub(crate) struct Rule<'a, 'b, H: LightHierarchy + ?Sized> {
     table: Option<&'b ImportanceTable>,
     /// The shading point, prepared for the decoded nodes.
     fast: FastQuery,
-    /// The shading point.
-    position: glam::Vec3,
-    /// `near_field^2` of the configuration.
-    near_field2: f32,
     /// Whether the prior component has weight (else its product is not
     /// tracked and stays 1, multiplied by a zero weight).
     prior: bool,
@@ -191,8 +181,6 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
             query: Query::new(ctx),
             table: guide.importance_table(),
             fast: FastQuery::new(ctx),
-            position: ctx.position,
-            near_field2: config.near_field * config.near_field,
             prior: mixture.prior > 0.0,
             mixture,
         }
@@ -204,7 +192,6 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
             node: self.guide.walk().root()?,
             light: self.tree.root()?,
             cut: self.nodes.first().copied(),
-            far: false,
         })
     }
 
@@ -228,30 +215,17 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
         }
     }
 
-    /// The importances of the two children of inner node `node` at the
-    /// shading point, and whether each lies in the far field (its distance
-    /// from the point above `near_field` times its bounding radius).
+    /// The importances of the two children of the inner node at `at` at the
+    /// shading point: from the decoded table (both children in one cache
+    /// line, found by the walk-table pair) when the guide has one.
     #[inline(always)]
-    fn child_importances(&self, node: u32) -> Option<((f64, f64), [bool; 2])> {
-        let [l, r] = self.tree.children(node)?;
-        let far = |(c, r2): (glam::Vec3, f32)| {
-            (self.position - c).length_squared() > self.near_field2 * r2
-        };
+    fn child_importances(&self, at: &Cursor) -> Option<(f64, f64)> {
         match self.table {
-            Some(t) => Some((
-                (t.importance(&self.fast, l), t.importance(&self.fast, r)),
-                [far(t.sphere(l)), far(t.sphere(r))],
-            )),
+            Some(t) => Some(t.pair_importance(&self.fast, at.node.children()?)),
             None => {
-                let (bl, br) = (self.tree.node_bounds(l), self.tree.node_bounds(r));
-                let sphere = |b: &crate::light_tree::NodeBounds| {
-                    let (c, d) = (b.bounds.center(), b.bounds.max - b.bounds.min);
-                    (c, 0.25 * d.length_squared())
-                };
-                Some((
-                    (self.query.importance(&bl), self.query.importance(&br)),
-                    [far(sphere(&bl)), far(sphere(&br))],
-                ))
+                let [l, r] = self.tree.children(at.light)?;
+                let imp = |n| self.query.importance(&self.tree.node_bounds(n));
+                Some((imp(l), imp(r)))
             }
         }
     }
@@ -271,18 +245,15 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
     #[inline(always)]
     fn step(&self, at: Cursor, split: f32) -> Step {
         let energy = decode_split(split);
-        let needs_importance = !at.far
-            && (self.prior_importance
-                || match at.cut {
-                    Some(_) => self.modulate,
-                    None => self.below == BelowCut::Importance,
-                });
-        let (imp, far) = match needs_importance
-            .then(|| self.child_importances(at.light))
-            .flatten()
-        {
-            Some((imp, far)) => (Some(imp), far),
-            None => (None, [at.far; 2]),
+        let needs_importance = self.prior_importance
+            || match at.cut {
+                Some(_) => self.modulate,
+                None => self.below == BelowCut::Importance,
+            };
+        let imp = if needs_importance {
+            self.child_importances(&at)
+        } else {
+            None
         };
         let by_importance = || {
             imp.and_then(|(l, r)| Descent::probabilities(l, r))
@@ -306,7 +277,6 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
                     cut: Some(cut),
                     prior,
                     next: [node.child(Side::Left), node.child(Side::Right)],
-                    far,
                 }
             }
             None => Step {
@@ -316,7 +286,6 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
                 },
                 prior,
                 next: [None, None],
-                far,
             },
         }
     }
@@ -376,7 +345,6 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
                 node: pair.0[k],
                 light: self.child_light(at.light, k),
                 cut: cuts[k],
-                far: step.far[k],
             };
             children = at.node.children().map(|_| grand[k]);
         }
@@ -403,6 +371,7 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
         // The path names every node, so the split loads are independent of
         // each other (unlike the walk table's chain, which `sample` follows
         // because it does not know the path in advance).
+        let walk = self.guide.walk();
         for &(node, side) in path.steps() {
             at.light = node;
             let step = self.step(at, self.guide.raw_split(node));
@@ -411,7 +380,14 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
                 return 0.0;
             }
             at.cut = step.next[side.index()].and_then(|i| self.nodes.get(i as usize).copied());
-            at.far = step.far[side.index()];
+            // Follow the walk table too (the importance table is laid out
+            // like it), only when it is read.
+            if self.table.is_some() {
+                match at.node.children() {
+                    Some(k) => at.node = walk.pair(k).0[side.index()],
+                    None => return 0.0,
+                }
+            }
         }
         self.mixture.emitter_pmf(p)
     }

@@ -77,6 +77,32 @@ pub(crate) struct WalkTable {
     pairs: Vec<WalkPair>,
 }
 
+/// Visits every inner node of `tree` depth-first, left before right, as
+/// `visit(k, (parent pair, side), node, children)`: `k` is the pair index
+/// the node's children get (1, 2, ... in visiting order) and `(parent
+/// pair, side)` where the node itself sits (the root at `(0, 0)`).
+fn visit_pairs<H: LightHierarchy + ?Sized>(
+    tree: &H,
+    mut visit: impl FnMut(usize, (usize, usize), u32, [u32; 2]),
+) {
+    let Some(root) = tree.root() else {
+        return;
+    };
+    let mut next = 1usize;
+    let mut stack = vec![(root, 0usize, 0usize)];
+    while let Some((node, pair, side)) = stack.pop() {
+        let Some([l, r]) = tree.children(node) else {
+            continue;
+        };
+        let k = next;
+        next += 1;
+        visit(k, (pair, side), node, [l, r]);
+        // Left on top: its subtree's pairs come first, depth-first.
+        stack.push((r, k, 1));
+        stack.push((l, k, 0));
+    }
+}
+
 impl WalkTable {
     /// Lays out `tree` with `split(node)` as each inner node's split entry.
     /// O(nodes), iterative (any depth).
@@ -97,23 +123,26 @@ impl WalkTable {
         };
         let mut pairs = Vec::with_capacity(tree.node_count() / 2 + 1);
         pairs.push(WalkPair([leaf(root), unused]));
-        // (light-tree node, its entry: pair index and side).
-        let mut stack = vec![(root, 0usize, 0usize)];
-        while let Some((node, pair, side)) = stack.pop() {
-            let Some([l, r]) = tree.children(node) else {
-                continue;
-            };
-            let k = pairs.len();
+        visit_pairs(tree, |k, (pair, side), node, [l, r]| {
             pairs[pair].0[side] = WalkNode {
                 split: split(node),
                 link: k as u32,
             };
             pairs.push(WalkPair([leaf(l), leaf(r)]));
-            // Left on top: its subtree's pairs come first, depth-first.
-            stack.push((r, k, 1));
-            stack.push((l, k, 0));
-        }
+        });
         Self { pairs }
+    }
+
+    /// The light-tree nodes of every pair, in the table's order (`None`
+    /// for the root's placeholder pair 0): what tables laid out like this
+    /// one are built from.
+    pub(crate) fn pair_nodes<H: LightHierarchy + ?Sized>(tree: &H) -> Vec<Option<[u32; 2]>> {
+        let mut nodes = Vec::new();
+        if tree.root().is_some() {
+            nodes.push(None);
+            visit_pairs(tree, |_, _, _, children| nodes.push(Some(children)));
+        }
+        nodes
     }
 
     /// The root's entry; `None` for an empty tree.
@@ -157,6 +186,8 @@ mod tests {
     fn check(tree: &LightTree) {
         let split = |n: u32| n as f32; // a tag that names the node
         let walk = WalkTable::new(tree, split);
+        let nodes = WalkTable::pair_nodes(tree);
+        assert_eq!(nodes.len(), walk.pairs.len());
         let Some(root) = tree.root() else {
             assert_eq!(walk.root(), None);
             assert_eq!(walk.bytes(), 0);
@@ -170,6 +201,7 @@ mod tests {
                 Some([l, r]) => {
                     assert_eq!(entry.split, node as f32);
                     let k = entry.children().expect("inner node");
+                    assert_eq!(nodes[k as usize], Some([l, r]));
                     assert!(!core::mem::replace(&mut seen[k as usize], true));
                     let pair = walk.pair(k);
                     stack.push((l, pair.0[0]));
