@@ -233,9 +233,9 @@ fn equals_a_glt_fed_the_same_light_splats() {
     .unwrap();
     let config = FieldConfig {
         cut,
+        light_filter: SpatialFilter::StochasticBox,
         ..config_with(200.0, SdTreeConfig::default())
     };
-    assert_eq!(config.light_filter, SpatialFilter::StochasticBox);
     let mut field = GuidingField::new(&tree, scene(), config).unwrap();
     let mut rng = Rand::seeded(4);
     let compare =

@@ -63,7 +63,7 @@ pub struct Args {
     /// the paper's `Le w / p`.
     #[arg(long)]
     pub contribution_splats: bool,
-    /// The GLT's light splats (`pt-glt`) jitter into neighbouring cells
+    /// Light splats (`pt-glt` and `ppg-glt`) jitter into neighbouring cells
     /// (PPG's stochastic box, as the paper does) instead of going to the
     /// shading point's own cell.
     #[arg(long)]

@@ -106,7 +106,8 @@ pub struct GuideParams {
     pub modulation: Modulation,
     /// Light splats carry `f cos Le w / p` (else the paper's `Le w / p`).
     pub contribution_splats: bool,
-    /// The spatial filter of the GLT's light splats (`pt-glt`).
+    /// The spatial filter of the light splats (`pt-glt`'s GLT and
+    /// `ppg-glt`'s field).
     pub glt_filter: SpatialFilter,
     /// The GLT's defensive prior.
     pub prior: Prior,
@@ -194,7 +195,7 @@ pub fn new_field<'a>(
     let config = FieldConfig {
         sd: sd_config(params),
         cut: cut_config(scene, params),
-        ..FieldConfig::default()
+        light_filter: params.glt_filter,
     };
     Some(
         GuidingField::new(&scene.light_tree, scene.bounds, config)

@@ -50,8 +50,8 @@ impl<H: LightHierarchy + ?Sized> GuidingField<'_, H> {
     /// [`GuidingTree::splat`](crate::glt::GuidingTree::splat) for what it
     /// is) into the cut of the cell(s) that
     /// [`FieldConfig::light_filter`](super::FieldConfig::light_filter)
-    /// spreads `p` over (the stochastic box by default: one `next_u64` of
-    /// `rng`). Bad input is dropped and counted in
+    /// spreads `p` over (by default the cell holding `p`; the stochastic
+    /// box draws one `next_u64` of `rng`). Bad input is dropped and counted in
     /// [`GuidingField::dropped_light_splats`]. Light splats add no spatial
     /// weight.
     #[inline]
