@@ -1194,6 +1194,24 @@ fn modulation_reproduces_the_learned_cut_at_the_anchor_and_follows_importance() 
         plain.refine(&mut a);
         modulated.refine(&mut b);
     }
+    // Splats without a position leave no anchor: that cut is sampled
+    // exactly like the unmodulated one.
+    let mut c = modulated.new_cut();
+    for _ in 0..3 {
+        for (i, e) in lights.iter().enumerate() {
+            let v = 1.0 / (e.bounds.center() - anchor).length_squared();
+            modulated.splat(&c, LightId::Emitter(i as u32), v);
+        }
+        modulated.refine(&mut c);
+    }
+    let far = ShadingContext::at(Vec3::new(-3.0, 0.0, 0.0));
+    for i in 0..32 {
+        assert_eq!(
+            plain.pmf_exact(&a, &far, LightId::Emitter(i)),
+            modulated.pmf_exact(&c, &far, LightId::Emitter(i)),
+            "light {i}: a cut without anchor is not modulated"
+        );
+    }
     let at = ShadingContext::at(anchor);
     for i in 0..32 {
         let (p, q) = (

@@ -52,8 +52,10 @@ pub enum Modulation {
     /// bound misses (visibility, the BSDF). Where both importances at `x`
     /// are zero the step falls back to `r`. Splats must carry their
     /// position for the anchor ([`crate::glt::Glt`] and the combined field
-    /// do; a cut splatted through [`crate::glt::GuidingTree::splat`] alone
-    /// has no anchor and keeps plain learned probabilities).
+    /// do, [`crate::glt::GuidingTree::splat_from`] does); a cut rebuilt
+    /// without one (splatted only through
+    /// [`crate::glt::GuidingTree::splat`]), like the initial cut, keeps
+    /// plain learned probabilities.
     Importance,
 }
 

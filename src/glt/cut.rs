@@ -40,6 +40,11 @@ pub struct GuidingCut {
     /// [`Modulation::Importance`](super::Modulation::Importance). Empty
     /// (no sums) without modulation.
     pub(super) anchor: SumBuffer,
+    /// Whether the sampled copy's `p_left` are learned factor ratios over
+    /// the importance at an anchor (set by a rebuild that had one), so
+    /// sampling modulates them by the importance at the shading point;
+    /// else they are plain learned probabilities.
+    pub(super) modulated: bool,
 }
 
 /// Why [`GuidingCut::check`] rejected a cut.
@@ -132,6 +137,7 @@ impl GuidingCut {
             env_fraction: config.environment.unwrap_or(0.0) as f32,
             recorded: Counter::new(),
             anchor: SumBuffer::new(anchor_sums(&config), config.accumulation),
+            modulated: false,
         }
     }
 

@@ -1,12 +1,13 @@
 //! Rebuilding a cut from what it collected: split where a slot's share is
 //! above `sigma`, end (merge) where it is not.
 
-use super::config::{CutConfig, Modulation, SplitPrior};
+use super::config::{Modulation, SplitPrior};
 use super::cut::{GuidingCut, sum_count};
 use super::cut_node::{CutNode, Slot};
 use super::guiding_tree::GuidingTree;
+use super::walk::WalkNode;
 use crate::emitter::ShadingContext;
-use crate::light_sampler::Query;
+use crate::light_sampler::{FastQuery, ImportanceTable};
 use crate::light_tree::LightHierarchy;
 use crate::math::Side;
 use alloc::vec;
@@ -21,6 +22,8 @@ struct Task {
     parent: u32,
     side: Side,
     light: u32,
+    /// The light node's walk-table entry (locates its children's pair).
+    walk: WalkNode,
     weight: f64,
     old: Option<u32>,
 }
@@ -59,11 +62,17 @@ impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
         }
         let rebuilt = total > 0.0 && total.is_finite();
         if rebuilt {
-            let anchor = match config.modulation {
-                Modulation::None => None,
-                Modulation::Importance => cut.anchor().map(|a| Query::new(&ShadingContext::at(a))),
+            // The importances at the anchor come from the same table (and
+            // the same function) that sampling modulates with, so at the
+            // anchor the modulated cut is exactly the learned one.
+            let anchor = match (config.modulation, self.importance_table()) {
+                (Modulation::Importance, Some(table)) => cut
+                    .anchor()
+                    .map(|a| (table, FastQuery::new(&ShadingContext::at(a)))),
+                _ => None,
             };
-            cut.nodes = rebuild(self.tree(), &cut.nodes, &sums, total, config, anchor);
+            cut.modulated = anchor.is_some();
+            cut.nodes = rebuild(self, &cut.nodes, &sums, total, anchor);
         }
         cut.sums.reset(sum_count(cut.nodes.len()));
         cut.anchor.clear();
@@ -117,12 +126,11 @@ fn split_weight<H: LightHierarchy + ?Sized>(
 /// their sum so a cluster that the bound calls dark there but that did
 /// collect splats keeps a finite factor; `None` when both are zero (or
 /// not finite).
-fn anchor_importances<H: LightHierarchy + ?Sized>(
-    tree: &H,
-    anchor: &Query,
-    children: [u32; 2],
+fn anchor_importances(
+    (table, anchor): (&ImportanceTable, FastQuery),
+    pair: u32,
 ) -> Option<(f64, f64)> {
-    let [l, r] = children.map(|c| anchor.importance(&tree.node_bounds(c)));
+    let (l, r) = table.pair_importance(&anchor, pair);
     let t = l + r;
     (t > 0.0 && t.is_finite()).then(|| (l.max(1e-6 * t), r.max(1e-6 * t)))
 }
@@ -145,14 +153,14 @@ fn stored_p_left(weights: (f64, f64), importances: Option<(f64, f64)>) -> f32 {
 }
 
 fn rebuild<H: LightHierarchy + ?Sized>(
-    tree: &H,
+    guide: &GuidingTree<'_, H>,
     old: &[CutNode],
     sums: &[f64],
     total: f64,
-    config: &CutConfig,
-    anchor: Option<Query>,
+    anchor: Option<(&ImportanceTable, FastQuery)>,
 ) -> Vec<CutNode> {
-    let Some(root) = tree.root() else {
+    let (tree, config, walk) = (guide.tree(), guide.config(), guide.walk());
+    let (Some(root), Some(root_walk)) = (tree.root(), walk.root()) else {
         return Vec::new();
     };
     let threshold = config.sigma * total;
@@ -162,15 +170,15 @@ fn rebuild<H: LightHierarchy + ?Sized>(
         parent: ROOT,
         side: Side::Left,
         light: root,
+        walk: root_walk,
         weight: total,
         old: (!old.is_empty()).then_some(0),
     }];
     while let Some(t) = stack.pop() {
         let mut slot = Slot::End(t.light);
-        if let Some(children) = tree.children(t.light).filter(|_| t.weight > threshold) {
-            let imp = anchor
-                .as_ref()
-                .and_then(|a| anchor_importances(tree, a, children));
+        let split = tree.children(t.light).zip(t.walk.children());
+        if let Some((children, pair)) = split.filter(|_| t.weight > threshold) {
+            let imp = anchor.and_then(|a| anchor_importances(a, pair));
             // Each side's weight and the old node that stands for it.
             let sides: [(f64, Option<u32>); 2] = match t.old.and_then(|i| old.get(i as usize)) {
                 Some(o) => {
@@ -208,12 +216,14 @@ fn rebuild<H: LightHierarchy + ?Sized>(
                 ));
                 // Right first so the left subtree is numbered first
                 // (pre-order).
+                let walks = walk.pair(pair).0;
                 for side in [Side::Right, Side::Left] {
                     let (weight, old) = sides[side.index()];
                     stack.push(Task {
                         parent: index,
                         side,
                         light: children[side.index()],
+                        walk: walks[side.index()],
                         weight,
                         old,
                     });

@@ -36,7 +36,7 @@ use super::cut_node::CutNode;
 use super::guiding_tree::{GuidingTree, decode_split};
 use super::walk::WalkNode;
 use crate::emitter::ShadingContext;
-use crate::light_sampler::{FastQuery, ImportanceTable, LightId, LightSample, LightSampler, Query};
+use crate::light_sampler::{FastQuery, ImportanceTable, LightId, LightSample, LightSampler};
 use crate::light_tree::LightHierarchy;
 use crate::math::{Descent, Side, pmf_to_f32};
 
@@ -93,13 +93,12 @@ impl Mixture {
     }
 }
 
-/// Where a walk is: a light-tree node's walk-table entry, the node itself
-/// (tracked only for [`BelowCut::Importance`], which reads its bounds) and,
-/// while inside the cut, the cut node that stands for it.
+/// Where a walk is: a light-tree node's walk-table entry (which also
+/// locates its children in the importance table) and, while inside the
+/// cut, the cut node that stands for it.
 #[derive(Clone, Copy, Debug)]
 struct Cursor {
     node: WalkNode,
-    light: u32,
     cut: Option<CutNode>,
 }
 
@@ -144,11 +143,8 @@ pub(crate) struct Rule<'a, 'b, H: LightHierarchy + ?Sized> {
     modulate: bool,
     /// Whether the prior component follows the importance ([`Prior`]).
     prior_importance: bool,
-    /// Whether the walk needs light-tree node ids (importance anywhere).
-    track_light: bool,
-    /// The shading point, prepared for importance evaluations.
-    query: Query,
-    /// The decoded nodes, when the configuration uses importance.
+    /// The decoded nodes; the guide has them whenever its configuration
+    /// uses importance.
     table: Option<&'b ImportanceTable>,
     /// The shading point, prepared for the decoded nodes.
     fast: FastQuery,
@@ -168,7 +164,7 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
     ) -> Self {
         let config = guide.config();
         let mixture = Mixture::new(guide.has_energy(), cut, config);
-        let modulate = config.modulation == Modulation::Importance;
+        let modulate = config.modulation == Modulation::Importance && cut.modulated;
         let prior_importance = config.prior == Prior::Importance;
         Self {
             guide,
@@ -177,8 +173,6 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
             below: config.below_cut,
             modulate,
             prior_importance,
-            track_light: modulate || prior_importance || config.below_cut == BelowCut::Importance,
-            query: Query::new(ctx),
             table: guide.importance_table(),
             fast: FastQuery::new(ctx),
             prior: mixture.prior > 0.0,
@@ -190,7 +184,6 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
     fn root(&self) -> Option<Cursor> {
         Some(Cursor {
             node: self.guide.walk().root()?,
-            light: self.tree.root()?,
             cut: self.nodes.first().copied(),
         })
     }
@@ -204,30 +197,12 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
             .map(|c| c.and_then(|i| self.nodes.get(i as usize).copied()))
     }
 
-    /// The light-tree node of child `side` of `light`, when the rule below
-    /// the cut needs it (else a placeholder: only importance reads it).
-    #[inline(always)]
-    fn child_light(&self, light: u32, side: usize) -> u32 {
-        if self.track_light {
-            self.tree.children(light).map_or(u32::MAX, |c| c[side])
-        } else {
-            0
-        }
-    }
-
     /// The importances of the two children of the inner node at `at` at the
-    /// shading point: from the decoded table (both children in one cache
-    /// line, found by the walk-table pair) when the guide has one.
+    /// shading point, from the decoded table (both children in one cache
+    /// line, found by the walk-table pair).
     #[inline(always)]
     fn child_importances(&self, at: &Cursor) -> Option<(f64, f64)> {
-        match self.table {
-            Some(t) => Some(t.pair_importance(&self.fast, at.node.children()?)),
-            None => {
-                let [l, r] = self.tree.children(at.light)?;
-                let imp = |n| self.query.importance(&self.tree.node_bounds(n));
-                Some((imp(l), imp(r)))
-            }
-        }
+        Some(self.table?.pair_importance(&self.fast, at.node.children()?))
     }
 
     /// The probabilities of both components at the inner node `at`, whose
@@ -343,7 +318,6 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
             let k = side.index();
             at = Cursor {
                 node: pair.0[k],
-                light: self.child_light(at.light, k),
                 cut: cuts[k],
             };
             children = at.node.children().map(|_| grand[k]);
@@ -373,7 +347,6 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
         // because it does not know the path in advance).
         let walk = self.guide.walk();
         for &(node, side) in path.steps() {
-            at.light = node;
             let step = self.step(at, self.guide.raw_split(node));
             self.apply(&mut p, &step, side);
             if p.cut == 0.0 && (!self.prior || p.prior == 0.0) {

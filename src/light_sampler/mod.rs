@@ -25,7 +25,6 @@ mod tree_walk;
 mod uniform;
 
 pub use environment::WithEnvironment;
-pub(crate) use importance::Query;
 pub use importance::importance;
 pub(crate) use importance_table::{FastQuery, ImportanceTable};
 pub use power::PowerSampler;
