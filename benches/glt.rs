@@ -83,7 +83,7 @@ fn trained_cut(lights: &[Emitter], guide: &GuidingTree<'_, LightTree>) -> Guidin
             let LightId::Emitter(e) = s.light else {
                 continue;
             };
-            guide.splat(&cut, s.light, contribution(lights, e, POINT) / s.pmf);
+            guide.splat_from(&cut, POINT, s.light, contribution(lights, e, POINT) / s.pmf);
         }
         guide.refine(&mut cut);
     }
@@ -232,6 +232,10 @@ fn bench_sampling(c: &mut Criterion) {
                         below_cut: BelowCut::Importance,
                         ..CutConfig::default()
                     },
+                ),
+                (
+                    "cut-with-importance/sample+pmf",
+                    CutConfig::default().with_importance(),
                 ),
             ] {
                 let guide = GuidingTree::new(&tree, config);
