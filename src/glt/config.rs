@@ -54,8 +54,9 @@ pub enum Modulation {
     /// position for the anchor ([`crate::glt::Glt`] and the combined field
     /// do, [`crate::glt::GuidingTree::splat_from`] does); a cut rebuilt
     /// without one (splatted only through
-    /// [`crate::glt::GuidingTree::splat`]), like the initial cut, keeps
-    /// plain learned probabilities.
+    /// [`crate::glt::GuidingTree::splat`]) keeps plain learned
+    /// probabilities. The initial cut has equal factors: it samples by the
+    /// importance at the shading point until it has learned.
     Importance,
 }
 

@@ -122,9 +122,18 @@ impl GuidingCut {
     /// The initial cut (see [`GuidingTree::new_cut`](super::GuidingTree::new_cut)).
     pub(crate) fn new<H: LightHierarchy + ?Sized>(tree: &H, config: &CutConfig) -> Self {
         let config = config.sanitized();
+        // Modulated, a cut that has learned nothing has equal factors on
+        // both sides, so it samples by the importance at the shading point
+        // (a dark side still gets nothing); else by the energy prior.
+        let modulated = config.modulation == super::Modulation::Importance;
         let nodes = match tree.root().and_then(|r| tree.children(r)) {
             Some([l, r]) => {
                 let (el, er) = (tree.energy(l) as f64, tree.energy(r) as f64);
+                let (el, er) = if modulated && el > 0.0 && er > 0.0 {
+                    (1.0, 1.0)
+                } else {
+                    (el, er)
+                };
                 let p = crate::math::Descent::probabilities(el, er).map_or(0.5, |(pl, _)| pl);
                 vec![CutNode::new(p as f32, [Slot::End(l), Slot::End(r)])]
             }
@@ -137,7 +146,7 @@ impl GuidingCut {
             env_fraction: config.environment.unwrap_or(0.0) as f32,
             recorded: Counter::new(),
             anchor: SumBuffer::new(anchor_sums(&config), config.accumulation),
-            modulated: false,
+            modulated,
         }
     }
 

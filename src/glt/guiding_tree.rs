@@ -157,7 +157,9 @@ impl<'a, H: LightHierarchy + ?Sized> GuidingTree<'a, H> {
     /// The initial cut of a cell: the light tree's root split by energy,
     /// `p_left = E(left) / (E(left) + E(right))` (the paper's code starts at
     /// 0.5/0.5 whatever the power), so sampling it is exactly
-    /// tree-by-energy sampling. A tree whose root is a leaf (or that is
+    /// tree-by-energy sampling (below the cut as [`BelowCut`](super::BelowCut)
+    /// says). With [`Modulation::Importance`](super::Modulation::Importance) both sides start with equal factors, so
+    /// the cut samples by the importance at the shading point. A tree whose root is a leaf (or that is
     /// empty) gets the empty cut. The environment fraction starts at its
     /// prior.
     pub fn new_cut(&self) -> GuidingCut {
