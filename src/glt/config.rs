@@ -183,14 +183,12 @@ impl Default for CutConfig {
 impl CutConfig {
     /// This configuration with every importance-based rule on:
     /// [`Modulation::Importance`], [`BelowCut::Importance`] and
-    /// [`Prior::Importance`]. It chooses lights better per sample (in the
-    /// render example's scenes, 1.3-1.9x lower variance of direct light at
-    /// first hits; docs/results.md) but evaluates two importances per level
-    /// of every walk, which costs more than it saves where rays are as cheap
-    /// as in the render example (0.65-0.96x its efficiency at equal time
-    /// there; 1.67x the instructions of a uniform-NEE path on `city`, 1.25x
-    /// for the default).
-    /// Renderers whose rays cost more than a light-tree walk should try it.
+    /// [`Prior::Importance`]: the learned cut follows the shading point
+    /// inside its cell. It costs two importance evaluations per level of
+    /// every walk and chooses lights better per sample; in the render
+    /// example it wins at equal time too (docs/results.md, "Light selection
+    /// against the physical limit"), and it is the recommended
+    /// configuration. It is not yet the default.
     pub fn with_importance(self) -> Self {
         Self {
             modulation: Modulation::Importance,
