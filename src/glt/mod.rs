@@ -26,7 +26,12 @@
 //! power at a non-zero pmf, so delta lights stay unbiased without MIS;
 //! cut nodes take 12 bytes, not 20; sums accumulate in `f64` or exactly,
 //! never in `f32`; the one-number descent is exact at any depth; paths have
-//! no 32-level limit; single-light and empty scenes work.
+//! no 32-level limit; single-light and empty scenes work; light splats go to
+//! the cell of their shading point, not jittered into neighbours (through
+//! walls). Beyond the paper, [`CutConfig::with_importance`] lets the learned
+//! cut follow the shading point inside its cell ([`Modulation`], [`Prior`],
+//! importance below the cut), from a decoded importance table
+//! (`src/light_sampler/importance_table.rs`).
 
 mod config;
 mod cut;
