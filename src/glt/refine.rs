@@ -135,6 +135,21 @@ fn anchor_importances(
     (t > 0.0 && t.is_finite()).then(|| (l.max(1e-6 * t), r.max(1e-6 * t)))
 }
 
+/// A fresh split's child weights in proportion to the (floored)
+/// importances at the anchor; a dark child (zero energy) gets nothing.
+/// `None` when no child can take the weight.
+fn split_by_importance<H: LightHierarchy + ?Sized>(
+    tree: &H,
+    [l, r]: [u32; 2],
+    weight: f64,
+    (il, ir): (f64, f64),
+) -> Option<(f64, f64)> {
+    let lit = |n: u32, i: f64| if tree.energy(n) > 0.0 { i } else { 0.0 };
+    let (il, ir) = (lit(l, il), lit(r, ir));
+    let t = il + ir;
+    (t > 0.0 && t.is_finite()).then(|| (weight * il / t, weight * ir / t))
+}
+
 /// The stored `p_left` from the two sides' weights: their ratio, or with an
 /// anchor ([`Modulation::Importance`]) the ratio of the learned factors
 /// `weight / importance at the anchor`.
@@ -193,13 +208,7 @@ fn rebuild<H: LightHierarchy + ?Sized>(
                     // importance there (equal learned factors), else by the
                     // split prior.
                     let (wl, wr) = imp
-                        .and_then(|(il, ir)| {
-                            let (el, er) = (tree.energy(children[0]), tree.energy(children[1]));
-                            let il = if el > 0.0 { il } else { 0.0 };
-                            let ir = if er > 0.0 { ir } else { 0.0 };
-                            Some((t.weight * il / (il + ir), t.weight * ir / (il + ir)))
-                                .filter(|(a, b)| (a + b).is_finite() && a + b > 0.0)
-                        })
+                        .and_then(|i| split_by_importance(tree, children, t.weight, i))
                         .unwrap_or_else(|| {
                             split_weight(tree, children, t.weight, config.split_prior)
                         });

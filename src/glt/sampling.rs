@@ -174,7 +174,11 @@ impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
             modulate,
             prior_importance,
             table: guide.importance_table(),
-            fast: FastQuery::new(ctx),
+            // Only the importance rules read the prepared point.
+            fast: match guide.importance_table() {
+                Some(_) => FastQuery::new(ctx),
+                None => FastQuery::unused(),
+            },
             prior: mixture.prior > 0.0,
             mixture,
         }

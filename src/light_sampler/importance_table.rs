@@ -145,6 +145,17 @@ impl FastQuery {
             finite: ctx.position.is_finite(),
         }
     }
+
+    /// A placeholder for walks that evaluate no importance (every
+    /// importance it gives is 0).
+    #[inline]
+    pub(crate) fn unused() -> Self {
+        Self {
+            p: Vec3::ZERO,
+            n: None,
+            finite: false,
+        }
+    }
 }
 
 #[inline(always)]
