@@ -43,46 +43,69 @@ impl GltVariant {
                 "alpha" => v.params.alpha = num()?,
                 "threshold" => v.params.glt_spatial_threshold = num()?,
                 "prior" => {
-                    v.params.prior = match val {
-                        "energy" => Prior::Energy,
-                        "importance" => Prior::Importance,
-                        _ => return Err(format!("`{kv}`: energy or importance")),
-                    }
+                    v.params.prior = pick(
+                        kv,
+                        val,
+                        [("energy", Prior::Energy), ("importance", Prior::Importance)],
+                    )?
+                }
+                "below" => {
+                    v.params.below_cut = pick(
+                        kv,
+                        val,
+                        [
+                            ("energy", BelowCut::Energy),
+                            ("importance", BelowCut::Importance),
+                        ],
+                    )?
+                }
+                "modulation" => {
+                    v.params.modulation = pick(
+                        kv,
+                        val,
+                        [
+                            ("none", Modulation::None),
+                            ("importance", Modulation::Importance),
+                        ],
+                    )?
+                }
+                "splat" => {
+                    v.params.contribution_splats =
+                        pick(kv, val, [("radiance", false), ("contribution", true)])?
+                }
+                "filter" => {
+                    v.params.glt_filter = pick(
+                        kv,
+                        val,
+                        [
+                            ("nearest", SpatialFilter::Nearest),
+                            ("jitter", SpatialFilter::StochasticBox),
+                        ],
+                    )?
                 }
                 "min-splats" => v.params.min_splats = num()? as u32,
                 "train-spp" => v.train_spp = num()? as u64,
-                "below" => {
-                    v.params.below_cut = match val {
-                        "energy" => BelowCut::Energy,
-                        "importance" => BelowCut::Importance,
-                        _ => return Err(format!("`{kv}`: energy or importance")),
-                    }
-                }
-                "modulation" => {
-                    v.params.modulation = match val {
-                        "none" => Modulation::None,
-                        "importance" => Modulation::Importance,
-                        _ => return Err(format!("`{kv}`: none or importance")),
-                    }
-                }
-                "splat" => {
-                    v.params.contribution_splats = match val {
-                        "radiance" => false,
-                        "contribution" => true,
-                        _ => return Err(format!("`{kv}`: radiance or contribution")),
-                    }
-                }
-                "filter" => {
-                    v.params.glt_filter = match val {
-                        "nearest" => SpatialFilter::Nearest,
-                        "jitter" => SpatialFilter::StochasticBox,
-                        _ => return Err(format!("`{kv}`: nearest or jitter")),
-                    }
-                }
                 _ => return Err(format!("`{kv}`: unknown key {k:?}")),
             }
         }
         v.name = format!("glt {}", spec.trim());
         Ok(v)
     }
+}
+
+/// The value named `val` among `choices` (`kv` is the whole setting, for
+/// the error).
+fn pick<T: Copy, const N: usize>(
+    kv: &str,
+    val: &str,
+    choices: [(&str, T); N],
+) -> Result<T, String> {
+    choices
+        .iter()
+        .find(|(name, _)| *name == val)
+        .map(|&(_, t)| t)
+        .ok_or_else(|| {
+            let names: Vec<&str> = choices.iter().map(|(n, _)| *n).collect();
+            format!("`{kv}`: expected {}", names.join(" or "))
+        })
 }
