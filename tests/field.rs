@@ -127,7 +127,7 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
             let val = value(&lights, emitter(s.light), p) / s.pmf;
             assert_eq!(
                 v.splat_light(s.light, val, &mut rng.0),
-                guide.splat(cut, s.light, val)
+                guide.splat_from(cut, p, s.light, val)
             );
             // Directions: sample, pdf, fraction, mixture.
             let u = [rng.f(), rng.f()];
@@ -499,7 +499,7 @@ fn spatial_split_copies_both_payloads() {
         assert_eq!(cell.cut().accumulated(), (0.0, 0.0));
     }
     let far = Vec3::new(9.0, 9.0, 9.0);
-    let (near_ctx, far_ctx) = (ShadingContext::at(p), ShadingContext::at(far));
+    let near_ctx = ShadingContext::at(p);
     let (vn, vf) = (field.vertex(p).unwrap(), field.vertex(far).unwrap());
     assert_ne!(vn.cell(), vf.cell());
     // One refinement from the uniform tree: the root level learned (about 4x).
@@ -508,9 +508,11 @@ fn spatial_split_copies_both_payloads() {
         vn.direction_pdf(dir).to_bits(),
         vf.direction_pdf(dir).to_bits()
     );
+    // The same learned cut in both cells: the same pmf at one point (with
+    // the default modulation it varies with the point, not with the cell).
     let l3 = LightId::Emitter(3);
     let p3 = vn.light_pmf_exact(&near_ctx, l3);
-    assert_eq!(p3.to_bits(), vf.light_pmf_exact(&far_ctx, l3).to_bits());
+    assert_eq!(p3.to_bits(), vf.light_pmf_exact(&near_ctx, l3).to_bits());
     // A second round near p, another direction and light: only that cell
     // learns it; the far one keeps its copies.
     let dir2 = Vec3::new(1.0, -0.3, 0.0);
@@ -524,7 +526,7 @@ fn spatial_split_copies_both_payloads() {
     let (vn, vf) = (field.vertex(p).unwrap(), field.vertex(far).unwrap());
     assert!(vn.direction_pdf(dir2) > 10.0 * vf.direction_pdf(dir2));
     assert_eq!(vf.direction_pdf(dir2).to_bits(), far_pdf.to_bits());
-    assert_eq!(vf.light_pmf_exact(&far_ctx, l3).to_bits(), p3.to_bits());
+    assert_eq!(vf.light_pmf_exact(&near_ctx, l3).to_bits(), p3.to_bits());
     assert!(vn.light_pmf_exact(&near_ctx, LightId::Emitter(30)) > 0.5);
 }
 
@@ -786,11 +788,14 @@ fn memory_report_adds_up_and_compares_cuts_with_quadtrees() {
         .sum();
     assert_eq!(m.cuts.nodes, nodes);
     assert_eq!(m.cuts.node_bytes, 12 * nodes);
-    assert_eq!(m.cuts.sum_bytes, 8 * (2 * nodes + m.sd.cells));
-    // Split table 4 B per node; walk table one 16-B pair per inner node + root.
+    // One sum per slot plus the environment's, and the default modulation's
+    // 7 anchor sums, per cell.
+    assert_eq!(m.cuts.sum_bytes, 8 * (2 * nodes + 8 * m.sd.cells));
+    // Split table 4 B per node; walk table one 16-B pair per inner node +
+    // root; the default importance rules' table one 64-B pair beside it.
     assert_eq!(
         m.shared_bytes,
-        4 * tree.node_count() + 8 * (tree.node_count() + 1)
+        4 * tree.node_count() + (8 + 32) * (tree.node_count() + 1)
     );
     assert_eq!(m.cut_bytes(), m.cuts.node_bytes + m.cuts.sum_bytes);
     assert_eq!(m.quadtree_bytes(), m.sd.quadtree_bytes);

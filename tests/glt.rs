@@ -358,11 +358,12 @@ fn learns_the_visible_subset() {
         .sum();
     for (below_cut, split_prior) in ALL_CONFIGS {
         for alpha in [0.0, 0.1, 0.3] {
+            // The energy prior, which `prior_outside` is computed for.
             let config = CutConfig {
                 alpha,
                 below_cut,
                 split_prior,
-                ..CutConfig::default()
+                ..CutConfig::default().with_paper_rules()
             };
             let guide = GuidingTree::new(&tree, config);
             let mass = |cut: &GuidingCut| -> f64 {
@@ -414,9 +415,10 @@ fn energy_split_prior_preserves_the_distribution() {
             alpha: 0.0,
             split_prior: prior,
             sigma: 0.002,
-            // The paper's rule: rebuild from any data (here two splats).
+            // The paper's rules: energy below the cut, one distribution per
+            // cell, rebuild from any data (here two splats).
             min_splats: 0,
-            ..CutConfig::default()
+            ..CutConfig::default().with_paper_rules()
         };
         let guide = GuidingTree::new(&tree, config);
         let mut cut = guide.new_cut();
@@ -970,10 +972,11 @@ fn prior_floor_survives_extreme_ratios() {
         Emitter::point(Vec3::Y, 1.0),
     ];
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
-    // The paper's rule: rebuild from any data (one splat per pass).
+    // The paper's rules (the energy prior), rebuilding from any data (one
+    // splat per pass).
     let config = CutConfig {
         min_splats: 0,
-        ..CutConfig::default()
+        ..CutConfig::default().with_paper_rules()
     };
     let guide = GuidingTree::new(&tree, config);
     let alpha = guide.config().alpha;
@@ -1129,7 +1132,9 @@ fn cut_node_is_twelve_bytes() {
         let m = cut.memory();
         assert_eq!(m.nodes, cut.nodes().len());
         assert_eq!(m.node_bytes, 12 * m.nodes);
-        assert_eq!(m.sum_bytes, per_sum * (2 * m.nodes + 1));
+        // One sum per slot and the environment's, plus the default
+        // modulation's 7 anchor sums.
+        assert_eq!(m.sum_bytes, per_sum * (2 * m.nodes + 1 + 7));
         assert_eq!(cut.heap_bytes(), m.node_bytes + m.sum_bytes);
     }
 }

@@ -101,8 +101,11 @@ fn learns_per_region_and_keeps_the_contract() {
 fn split_cells_inherit_the_cut() {
     let lights = two_rooms();
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    // The paper's rules: one distribution per cell, so equal cuts give equal
+    // pmfs anywhere.
     let config = GltConfig {
         spatial_threshold: 100.0,
+        cut: CutConfig::default().with_paper_rules(),
         ..GltConfig::default()
     };
     let mut glt = Glt::new(&tree, scene(), config).unwrap();
@@ -356,12 +359,15 @@ fn memory_report_adds_up() {
         .sum();
     assert_eq!(m.cuts.nodes, nodes);
     assert_eq!(m.cuts.node_bytes, 12 * nodes);
-    assert_eq!(m.cuts.sum_bytes, 8 * (2 * nodes + m.cells));
+    // One sum per slot plus the environment's, and the default modulation's
+    // 7 anchor sums, per cell.
+    assert_eq!(m.cuts.sum_bytes, 8 * (2 * nodes + 8 * m.cells));
     assert_eq!(m.spatial_bytes, glt.spatial().bytes());
-    // Split table 4 B per node; walk table one 16-B pair per inner node + root.
+    // Split table 4 B per node; walk table one 16-B pair per inner node +
+    // root; the default importance rules' table one 64-B pair beside it.
     assert_eq!(
         m.shared_bytes,
-        4 * tree.node_count() + 8 * (tree.node_count() + 1)
+        4 * tree.node_count() + (8 + 32) * (tree.node_count() + 1)
     );
     assert_eq!(
         m.total(),

@@ -28,9 +28,9 @@ impl GltVariant {
     /// Parses `spec`: space-separated `key=value` (sigma, alpha,
     /// below=energy|importance, modulation=none|importance,
     /// splat=radiance|contribution, filter=nearest|jitter,
-    /// prior=energy|importance, min-splats,
-    /// threshold, train-spp) applied
-    /// to the defaults.
+    /// prior=energy|importance, rules=paper (the paper's rules, see the
+    /// render example's `--paper-rules`), min-splats, threshold,
+    /// train-spp) applied in order to the defaults.
     pub fn parse(spec: &str, train_spp: u64) -> Result<Self, String> {
         let mut v = Self::defaults(train_spp);
         for kv in spec.split_whitespace() {
@@ -82,6 +82,11 @@ impl GltVariant {
                             ("jitter", SpatialFilter::StochasticBox),
                         ],
                     )?
+                }
+                "rules" => {
+                    if pick(kv, val, [("paper", true), ("default", false)])? {
+                        v.params = v.params.paper_rules();
+                    }
                 }
                 "min-splats" => v.params.min_splats = num()? as u32,
                 "train-spp" => v.train_spp = num()? as u64,

@@ -85,8 +85,10 @@ struct Args {
     #[arg(long, default_value_t = 64)]
     bsdf_samples: usize,
     /// GLT variants besides the defaults: space-separated `key=value`
-    /// settings (sigma, alpha, below=energy|importance, min-splats,
-    /// threshold, train-spp); repeat the flag for several.
+    /// settings (sigma, alpha, below=energy|importance,
+    /// modulation=none|importance, prior=energy|importance,
+    /// splat=radiance|contribution, filter=nearest|jitter, rules=paper,
+    /// min-splats, threshold, train-spp); repeat the flag for several.
     #[arg(long)]
     glt: Vec<String>,
     /// Samples per pixel the GLT trains with (the render example's

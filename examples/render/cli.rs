@@ -44,8 +44,9 @@ pub struct Args {
     #[arg(long, default_value_t = 0.01)]
     pub sigma: f64,
     /// How the GLT chooses below its cut: `energy` (the paper) or
-    /// `importance` (Estevez-Kulla importance of the light tree's nodes).
-    #[arg(long, default_value = "energy", value_parser = parse_below_cut)]
+    /// `importance` (Estevez-Kulla importance of the light tree's nodes;
+    /// the crate's default).
+    #[arg(long, default_value = "importance", value_parser = parse_below_cut)]
     pub below_cut: BelowCut,
     /// The fewest non-zero light splats a cut rebuilds from
     /// (`guiding::glt::CutConfig::min_splats`; 0 = the paper's rule).
@@ -56,8 +57,9 @@ pub struct Args {
     #[arg(long, default_value_t = guiding::glt::CutConfig::default().alpha)]
     pub alpha: f64,
     /// Whether the GLT's cut probabilities vary inside a cell: `none` (the
-    /// paper) or `importance` (learned factor x importance at the point).
-    #[arg(long, default_value = "none", value_parser = parse_modulation)]
+    /// paper) or `importance` (learned factor x importance at the point;
+    /// the crate's default).
+    #[arg(long, default_value = "importance", value_parser = parse_modulation)]
     pub modulation: Modulation,
     /// Light splats carry the full contribution `f cos Le w / p` instead of
     /// the paper's `Le w / p`.
@@ -68,9 +70,17 @@ pub struct Args {
     /// shading point's own cell.
     #[arg(long)]
     pub glt_jitter: bool,
-    /// The GLT's defensive prior: `energy` or `importance`.
-    #[arg(long, default_value = "energy", value_parser = parse_prior)]
+    /// The GLT's defensive prior: `energy` (the paper's power sampling) or
+    /// `importance` (the crate's default).
+    #[arg(long, default_value = "importance", value_parser = parse_prior)]
     pub prior: Prior,
+    /// Run `pt-glt` and `ppg-glt` exactly as the paper describes: energy
+    /// below the cut, one distribution per cell, no defensive mixture
+    /// (alpha 0), rebuild from any data (min-splats 0), jittered light
+    /// splats. Overrides `--below-cut`, `--modulation`, `--prior`,
+    /// `--alpha`, `--min-splats` and `--glt-jitter`.
+    #[arg(long)]
+    pub paper_rules: bool,
     /// Worker threads [default: all cores].
     #[arg(long)]
     pub threads: Option<usize>,

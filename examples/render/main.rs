@@ -108,26 +108,30 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
     } else {
         scenes::Size::Full
     };
+    let mut params = GuideParams {
+        sigma: args.sigma,
+        spatial_threshold: args.spatial_threshold,
+        glt_spatial_threshold: args.glt_spatial_threshold,
+        below_cut: args.below_cut,
+        min_splats: args.min_splats,
+        alpha: args.alpha,
+        modulation: args.modulation,
+        contribution_splats: args.contribution_splats,
+        glt_filter: if args.glt_jitter {
+            SpatialFilter::StochasticBox
+        } else {
+            SpatialFilter::Nearest
+        },
+        prior: args.prior,
+    };
+    if args.paper_rules {
+        params = params.paper_rules();
+    }
     let settings = Settings {
         width: args.width,
         height: args.height,
         budget,
-        params: GuideParams {
-            sigma: args.sigma,
-            spatial_threshold: args.spatial_threshold,
-            glt_spatial_threshold: args.glt_spatial_threshold,
-            below_cut: args.below_cut,
-            min_splats: args.min_splats,
-            alpha: args.alpha,
-            modulation: args.modulation,
-            contribution_splats: args.contribution_splats,
-            glt_filter: if args.glt_jitter {
-                SpatialFilter::StochasticBox
-            } else {
-                SpatialFilter::Nearest
-            },
-            prior: args.prior,
-        },
+        params,
         seed: args.seed,
         progress: !args.quiet,
     };

@@ -133,6 +133,24 @@ impl Default for GuideParams {
     }
 }
 
+impl GuideParams {
+    /// These parameters with the paper's GLT rules: energy below the cut,
+    /// one distribution per cell, the energy prior at weight 0 (no
+    /// defensive mixture), rebuild from any data, jittered light splats.
+    pub fn paper_rules(self) -> Self {
+        let cut = CutConfig::default().with_paper_rules();
+        Self {
+            below_cut: cut.below_cut,
+            modulation: cut.modulation,
+            prior: cut.prior,
+            alpha: 0.0,
+            min_splats: 0,
+            glt_filter: SpatialFilter::StochasticBox,
+            ..self
+        }
+    }
+}
+
 /// A fixed (untrained) light sampler for `method`, with the scene's
 /// environment light beside it; `None` for GLT methods.
 pub fn fixed_sampler<'a>(

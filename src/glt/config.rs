@@ -9,7 +9,6 @@ pub enum BelowCut {
     /// By the light tree's subtree energy, as the paper does (one read of
     /// the [`GuidingTree`](super::GuidingTree)'s split table per level);
     /// independent of the shading point.
-    #[default]
     Energy,
     /// By the Estevez-Kulla / pbrt-v4 importance (power x orientation /
     /// distance^2) at the shading point, the paper's suggestion for future
@@ -19,8 +18,9 @@ pub enum BelowCut {
     /// Measured in the synthetic scene described at [`CutConfig::alpha`]
     /// (`tests/glt_defaults.rs`): 1.5-2.5x lower variance than
     /// [`BelowCut::Energy`] at equal alpha, for a costlier walk below the
-    /// cut (two node decodes and importance evaluations per level). The
-    /// default stays [`BelowCut::Energy`] until measured in a renderer.
+    /// cut (two importance evaluations per level). The default, with the
+    /// other importance rules (see [`CutConfig::with_importance`]).
+    #[default]
     Importance,
 }
 
@@ -31,7 +31,6 @@ pub enum Modulation {
     /// One distribution for the whole cell: at a cut node the left child
     /// has the learned probability `p_left`, wherever the shading point
     /// is (the paper).
-    #[default]
     None,
     /// The learned quantity is a per-cluster correction factor on top of
     /// the analytic importance (`crate::light_sampler::importance`): at
@@ -56,7 +55,8 @@ pub enum Modulation {
     /// without one (splatted only through
     /// [`crate::glt::GuidingTree::splat`]) keeps plain learned
     /// probabilities. The initial cut has equal factors: it samples by the
-    /// importance at the shading point until it has learned.
+    /// importance at the shading point until it has learned. The default.
+    #[default]
     Importance,
 }
 
@@ -66,8 +66,7 @@ pub enum Modulation {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Prior {
     /// Tree-by-energy from the light tree's root: power sampling, the same
-    /// at every shading point.
-    #[default]
+    /// at every shading point (the paper).
     Energy,
     /// Tree-by-importance from the root (the Estevez-Kulla / pbrt-v4 rule
     /// of [`crate::ImportanceTreeSampler`], energy where both children's
@@ -75,6 +74,8 @@ pub enum Prior {
     /// emitter that can reach the point keeps a non-zero pmf. With
     /// [`Modulation::Importance`] and [`BelowCut::Importance`] the walk
     /// evaluates these importances anyway, so the better prior is free.
+    /// The default.
+    #[default]
     Importance,
 }
 
@@ -131,13 +132,13 @@ pub struct CutConfig {
     /// the paper's behaviour (biased for delta lights the cut never
     /// learned).
     pub alpha: f64,
-    /// How to continue below the cut. Default [`BelowCut::Energy`].
+    /// How to continue below the cut. Default [`BelowCut::Importance`].
     pub below_cut: BelowCut,
     /// Whether the cut's probabilities vary inside a cell. Default
-    /// [`Modulation::None`].
+    /// [`Modulation::Importance`].
     pub modulation: Modulation,
     /// The prior component of the defensive mixture. Default
-    /// [`Prior::Energy`].
+    /// [`Prior::Importance`].
     pub prior: Prior,
     /// How a newly split slot's weight is shared. Default
     /// [`SplitPrior::Half`].
@@ -169,9 +170,9 @@ impl Default for CutConfig {
         Self {
             sigma: 0.01,
             alpha: 0.2,
-            below_cut: BelowCut::Energy,
-            modulation: Modulation::None,
-            prior: Prior::Energy,
+            below_cut: BelowCut::Importance,
+            modulation: Modulation::Importance,
+            prior: Prior::Importance,
             split_prior: SplitPrior::Half,
             environment: None,
             accumulation: Accumulation::Fast,
@@ -181,19 +182,32 @@ impl Default for CutConfig {
 }
 
 impl CutConfig {
-    /// This configuration with every importance-based rule on:
-    /// [`Modulation::Importance`], [`BelowCut::Importance`] and
+    /// This configuration with every importance-based rule on (the
+    /// default): [`Modulation::Importance`], [`BelowCut::Importance`] and
     /// [`Prior::Importance`]: the learned cut follows the shading point
     /// inside its cell. It costs two importance evaluations per level of
     /// every walk and chooses lights better per sample; in the render
     /// example it wins at equal time too (docs/results.md, "Light selection
-    /// against the physical limit"), and it is the recommended
-    /// configuration. It is not yet the default.
+    /// against the physical limit").
     pub fn with_importance(self) -> Self {
         Self {
             modulation: Modulation::Importance,
             below_cut: BelowCut::Importance,
             prior: Prior::Importance,
+            ..self
+        }
+    }
+
+    /// This configuration with the paper's rules: [`Modulation::None`],
+    /// [`BelowCut::Energy`] and [`Prior::Energy`]. One learned distribution
+    /// per cell, continued below the cut by subtree energy, independent of
+    /// the shading point: the cheapest walk (one table read per level) and
+    /// the configuration to compare against the paper with.
+    pub fn with_paper_rules(self) -> Self {
+        Self {
+            modulation: Modulation::None,
+            below_cut: BelowCut::Energy,
+            prior: Prior::Energy,
             ..self
         }
     }

@@ -22,16 +22,18 @@
 //!
 //! How it differs from the paper's code (see the crate's reference notes):
 //! the initial cut is the energy prior, not 0.5/0.5; a defensive mixture
-//! with the energy prior (`alpha`, default 0.2) keeps every emitter with
+//! with a prior (`alpha`, default 0.2) keeps every emitter with
 //! power at a non-zero pmf, so delta lights stay unbiased without MIS;
 //! cut nodes take 12 bytes, not 20; sums accumulate in `f64` or exactly,
 //! never in `f32`; the one-number descent is exact at any depth; paths have
 //! no 32-level limit; single-light and empty scenes work; light splats go to
 //! the cell of their shading point, not jittered into neighbours (through
-//! walls). Beyond the paper, [`CutConfig::with_importance`] lets the learned
-//! cut follow the shading point inside its cell ([`Modulation`], [`Prior`],
-//! importance below the cut), from a decoded importance table
-//! (`src/light_sampler/importance_table.rs`).
+//! walls). Beyond the paper, by default the learned cut follows the
+//! shading point inside its cell ([`Modulation`], [`Prior`], importance
+//! below the cut: [`CutConfig::with_importance`]), from a decoded
+//! importance table (`src/light_sampler/importance_table.rs`);
+//! [`CutConfig::with_paper_rules`] gives the paper's one distribution per
+//! cell.
 
 mod config;
 mod cut;
