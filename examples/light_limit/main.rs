@@ -15,7 +15,13 @@
 //! ```text
 //! cargo run --release --example light_limit -- --scene city,ring,torus --points 300 --json out/light_limit.json
 //! cargo run --release --example light_limit -- --scene city --glt "sigma=0.002" --glt "alpha=0.1 below=importance"
+//! cargo run --release --example light_limit -- --scene city --breakdown
 //! ```
+//!
+//! `--breakdown` prints, per GLT variant, where its variance comes from:
+//! the share of the worst points, and the share of the next-event second
+//! moment on lights whose pmf is 2, 10 or 100 times below the clairvoyant
+//! one (and how much of that sits at the defensive prior's floor).
 //!
 //! The scene, geometry and training code are the render example's own
 //! files (`#[path]`), so the GLT measured is exactly the one `pt-glt`
@@ -46,6 +52,7 @@ mod scene;
 #[path = "../render/scenes/mod.rs"]
 mod scenes;
 
+mod breakdown;
 mod brute_force;
 mod glt_variant;
 mod shading_points;
@@ -113,6 +120,10 @@ struct Args {
     /// Write the records as a JSON array here.
     #[arg(long)]
     json: Option<PathBuf>,
+    /// Also print, per GLT variant, where its variance comes from (worst
+    /// points; lights by how far their pmf is below the clairvoyant's).
+    #[arg(long)]
+    breakdown: bool,
 }
 
 /// One measured method on one scene.
@@ -243,6 +254,29 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
         let (_, trained) = run::render_trained(&scene, Method::PtGlt, &settings);
         let glt = trained.glt.ok_or("pt-glt trains a GLT")?;
         let v = pmfs_of(&points, |ctx, l| f64::from(glt.pmf(ctx, l)));
+        if args.breakdown {
+            let pmf_vectors =
+                |f: &(dyn Fn(&ShadingContext, LightId) -> f64 + Sync)| -> Vec<Vec<f64>> {
+                    points
+                        .par_iter()
+                        .map(|t| {
+                            let ctx = ShadingContext::on_surface(t.at.p, t.at.n);
+                            t.lights.iter().map(|l| f(&ctx, l.light)).collect()
+                        })
+                        .collect()
+                };
+            let pmfs = pmf_vectors(&|ctx, l| f64::from(glt.pmf(ctx, l)));
+            let bvh = methods::fixed_sampler(&scene, Method::PtBvh).ok_or("bvh")?;
+            let prior = pmf_vectors(&|ctx, l| f64::from(bvh.pmf(ctx, l)));
+            let clair: Vec<f64> = points
+                .par_iter()
+                .map(|t| variance::variance(t, &variance::clairvoyant(t)))
+                .collect();
+            print!(
+                "{}",
+                breakdown::report(&points, &v, &clair, &pmfs, &prior, variant.params.alpha)
+            );
+        }
         records.push(record(
             &variant.name,
             &v,
