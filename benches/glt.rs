@@ -216,26 +216,28 @@ fn bench_sampling(c: &mut Criterion) {
             });
         }
         if n == 10_000 {
-            // Variants at one size: no prior mixture (the paper), importance
-            // below the cut, and the whole Glt (spatial lookup included).
+            // Variants at one size: the paper's rules (one distribution per
+            // cell, energy below the cut and as the prior), without the
+            // prior mixture, with importance below the cut only; and the
+            // whole Glt (spatial lookup included).
             for (name, config) in [
+                (
+                    "cut-paper-rules/sample+pmf",
+                    CutConfig::default().with_paper_rules(),
+                ),
                 (
                     "cut-alpha0/sample+pmf",
                     CutConfig {
                         alpha: 0.0,
-                        ..CutConfig::default()
+                        ..CutConfig::default().with_paper_rules()
                     },
                 ),
                 (
                     "cut-importance/sample+pmf",
                     CutConfig {
                         below_cut: BelowCut::Importance,
-                        ..CutConfig::default()
+                        ..CutConfig::default().with_paper_rules()
                     },
-                ),
-                (
-                    "cut-with-importance/sample+pmf",
-                    CutConfig::default().with_importance(),
                 ),
             ] {
                 let guide = GuidingTree::new(&tree, config);
