@@ -83,9 +83,9 @@ fn record(lights: &[Emitter], rng: &mut Rand) -> Record {
 }
 
 struct Trained<'a> {
-    field: GuidingField<'a, LightTree>,
+    field: GuidingField<&'a LightTree>,
     sd: SdTree,
-    glt: Glt<'a, LightTree>,
+    glt: Glt<&'a LightTree>,
 }
 
 fn train<'a>(lights: &[Emitter], tree: &'a LightTree) -> Trained<'a> {

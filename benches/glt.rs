@@ -70,7 +70,7 @@ fn contribution(lights: &[Emitter], e: u32, p: Vec3) -> f32 {
 
 const POINT: Vec3 = Vec3::new(10.0, -20.0, 5.0);
 
-fn trained_cut(lights: &[Emitter], guide: &GuidingTree<'_, LightTree>) -> GuidingCut {
+fn trained_cut(lights: &[Emitter], guide: &GuidingTree<&LightTree>) -> GuidingCut {
     let mut rng = Rand::new(7);
     let ctx = ShadingContext::on_surface(POINT, Vec3::Y);
     let mut cut = guide.new_cut();
@@ -344,7 +344,7 @@ fn bench_sampling(c: &mut Criterion) {
 }
 
 /// A Glt over the scene trained at random points.
-fn trained_glt<'a>(lights: &[Emitter], tree: &'a LightTree) -> Glt<'a, LightTree> {
+fn trained_glt<'a>(lights: &[Emitter], tree: &'a LightTree) -> Glt<&'a LightTree> {
     let bounds = Aabb::new(Vec3::splat(-100.0), Vec3::splat(100.0));
     let mut glt = Glt::new(
         tree,

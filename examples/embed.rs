@@ -83,7 +83,7 @@ fn mis(a: f32, b: f32) -> f32 {
 fn estimate(
     lights: &[Sphere],
     sampler: &dyn LightSampler,
-    glt: Option<&Glt<LightTree>>,
+    glt: Option<&Glt<&LightTree>>,
     p: Vec3,
     rng: &mut Pcg32,
 ) -> f32 {

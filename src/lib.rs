@@ -92,6 +92,14 @@ pub mod schedule;
 pub mod sd_tree;
 pub mod spatial;
 
+/// The vector types of the public API (`Vec3`, ...): glam 0.34, re-exported
+/// so a renderer on another glam version names the crate's own.
+pub use glam;
+/// The random-number trait that filtered records take (`RngCore`):
+/// rand_core 0.10, re-exported so a renderer on another version can wrap
+/// its generator in this one's trait.
+pub use rand_core;
+
 pub use emitter::{Emitter, Emitters, ShadingContext};
 pub use light_sampler::{
     EnergyTreeSampler, ImportanceTreeSampler, LightId, LightSample, LightSampler, PowerSampler,

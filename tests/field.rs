@@ -238,36 +238,35 @@ fn equals_a_glt_fed_the_same_light_splats() {
     };
     let mut field = GuidingField::new(&tree, scene(), config).unwrap();
     let mut rng = Rand::seeded(4);
-    let compare =
-        |field: &GuidingField<'_, LightTree>, glt: &Glt<'_, LightTree>, rng: &mut Rand| {
-            assert_eq!(field.cell_count(), glt.spatial().cell_count());
-            for c in field.spatial().cells() {
-                let b = field.spatial().cell_bounds(c);
-                assert_eq!(bounds_bits(b), bounds_bits(glt.spatial().cell_bounds(c)));
-                let (x, y) = (field.spatial().data(c).cut(), glt.spatial().data(c).cut());
-                assert_eq!(cut_bytes(x), cut_bytes(y));
-                let (xa, ya) = (x.accumulated(), y.accumulated());
+    let compare = |field: &GuidingField<&LightTree>, glt: &Glt<&LightTree>, rng: &mut Rand| {
+        assert_eq!(field.cell_count(), glt.spatial().cell_count());
+        for c in field.spatial().cells() {
+            let b = field.spatial().cell_bounds(c);
+            assert_eq!(bounds_bits(b), bounds_bits(glt.spatial().cell_bounds(c)));
+            let (x, y) = (field.spatial().data(c).cut(), glt.spatial().data(c).cut());
+            assert_eq!(cut_bytes(x), cut_bytes(y));
+            let (xa, ya) = (x.accumulated(), y.accumulated());
+            assert_eq!(
+                (xa.0.to_bits(), xa.1.to_bits()),
+                (ya.0.to_bits(), ya.1.to_bits())
+            );
+        }
+        for _ in 0..100 {
+            let ctx = ShadingContext::at(rng.point(10.5));
+            let u = rng.f();
+            assert_eq!(field.sample(&ctx, u), glt.sample(&ctx, u));
+            let v = field.vertex(ctx.position).unwrap();
+            assert_eq!(v.sample(&ctx, u), glt.sample(&ctx, u));
+            for e in [3, 44, 71] {
+                let l = LightId::Emitter(e);
+                assert_eq!(field.pmf(&ctx, l).to_bits(), glt.pmf(&ctx, l).to_bits());
                 assert_eq!(
-                    (xa.0.to_bits(), xa.1.to_bits()),
-                    (ya.0.to_bits(), ya.1.to_bits())
+                    v.light_pmf_exact(&ctx, l).to_bits(),
+                    glt.pmf_exact(&ctx, l).to_bits()
                 );
             }
-            for _ in 0..100 {
-                let ctx = ShadingContext::at(rng.point(10.5));
-                let u = rng.f();
-                assert_eq!(field.sample(&ctx, u), glt.sample(&ctx, u));
-                let v = field.vertex(ctx.position).unwrap();
-                assert_eq!(v.sample(&ctx, u), glt.sample(&ctx, u));
-                for e in [3, 44, 71] {
-                    let l = LightId::Emitter(e);
-                    assert_eq!(field.pmf(&ctx, l).to_bits(), glt.pmf(&ctx, l).to_bits());
-                    assert_eq!(
-                        v.light_pmf_exact(&ctx, l).to_bits(),
-                        glt.pmf_exact(&ctx, l).to_bits()
-                    );
-                }
-            }
-        };
+        }
+    };
     for _ in 0..4 {
         for _ in 0..150 {
             let p = rng.point(9.8);
@@ -397,8 +396,8 @@ fn trained_field<'a>(
     tree: &'a LightTree,
     lights: &[Emitter],
     config: FieldConfig,
-    mut after_refine: impl FnMut(&GuidingField<'a, LightTree>, RefineOutcome),
-) -> GuidingField<'a, LightTree> {
+    mut after_refine: impl FnMut(&GuidingField<&'a LightTree>, RefineOutcome),
+) -> GuidingField<&'a LightTree> {
     let mut field = GuidingField::new(tree, scene(), config).unwrap();
     let mut rng = Rand::seeded(8);
     for it in 0..4 {
@@ -471,7 +470,7 @@ fn spatial_split_copies_both_payloads() {
     let p = Vec3::new(-9.0, -9.0, -9.0);
     let dir = Vec3::new(0.2, 1.0, 0.1);
     let mut rng = Rand::seeded(6);
-    let round = |field: &GuidingField<'_, LightTree>, rng: &mut Rand| {
+    let round = |field: &GuidingField<&LightTree>, rng: &mut Rand| {
         let v = field.vertex(p).unwrap();
         for _ in 0..1000 {
             assert!(v.splat_radiance(dir, 1.0, 1.0, &mut rng.0));
@@ -663,7 +662,7 @@ fn inputs(lights: &[Emitter], n: usize, seed: u64) -> Vec<Input> {
         .collect()
 }
 
-fn apply(field: &GuidingField<'_, LightTree>, input: &Input) {
+fn apply(field: &GuidingField<&LightTree>, input: &Input) {
     let mut rng = Pcg32::seed_from_u64(input.seed);
     let v = field.vertex(input.p).unwrap();
     assert!(v.splat_radiance(input.dir, input.radiance, UNIFORM_PDF, &mut rng));
@@ -678,7 +677,7 @@ fn apply(field: &GuidingField<'_, LightTree>, input: &Input) {
 
 /// Feeds a batch from `threads` threads (0: the calling thread, in reverse
 /// order).
-fn feed(field: &GuidingField<'_, LightTree>, batch: &[Input], threads: usize) {
+fn feed(field: &GuidingField<&LightTree>, batch: &[Input], threads: usize) {
     if threads == 0 {
         batch.iter().rev().for_each(|i| apply(field, i));
         return;
@@ -698,7 +697,7 @@ fn feed(field: &GuidingField<'_, LightTree>, batch: &[Input], threads: usize) {
 
 /// Everything learned, as bits: cells, quadtrees, fractions, weights,
 /// cuts and their sums.
-fn fingerprint(field: &GuidingField<'_, LightTree>) -> Vec<u64> {
+fn fingerprint(field: &GuidingField<&LightTree>) -> Vec<u64> {
     let cells = field.spatial();
     let mut out = vec![cells.cell_count() as u64];
     for c in cells.cells() {

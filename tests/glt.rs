@@ -65,7 +65,7 @@ fn assert_valid_cut<H: LightHierarchy + ?Sized>(tree: &H, cut: &GuidingCut) {
 
 /// Sum of the exact pmf over every emitter and the environment.
 fn pmf_total<H: LightHierarchy + ?Sized>(
-    guide: &GuidingTree<'_, H>,
+    guide: &GuidingTree<&H>,
     cut: &GuidingCut,
     ctx: &ShadingContext,
 ) -> f64 {
@@ -79,7 +79,7 @@ fn pmf_total<H: LightHierarchy + ?Sized>(
 }
 
 /// What the total pmf must be: 1 when anything can be sampled.
-fn expected_total<H: LightHierarchy + ?Sized>(guide: &GuidingTree<'_, H>) -> f64 {
+fn expected_total<H: LightHierarchy + ?Sized>(guide: &GuidingTree<&H>) -> f64 {
     let tree = guide.tree();
     let emitters = tree.root().is_some_and(|r| tree.energy(r) > 0.0);
     let env = guide.config().environment.is_some();
@@ -89,7 +89,7 @@ fn expected_total<H: LightHierarchy + ?Sized>(guide: &GuidingTree<'_, H>) -> f64
 /// `sample`'s pmf equals `pmf()` bit for bit, in `f64` and in `f32`, and a
 /// sampled light always has a positive pmf.
 fn assert_sample_matches_pmf<H: LightHierarchy + ?Sized>(
-    guide: &GuidingTree<'_, H>,
+    guide: &GuidingTree<&H>,
     cut: &GuidingCut,
     ctx: &ShadingContext,
     rng: &mut Rand,
@@ -1231,7 +1231,7 @@ fn modulation_reproduces_the_learned_cut_at_the_anchor_and_follows_importance() 
     // Near the row's start the first lights matter far more than at the
     // anchor; the plain cut cannot know.
     let near = ShadingContext::at(Vec3::new(0.0, 0.0, 0.0));
-    let first = |g: &GuidingTree<LightTree>, c| g.pmf_exact(c, &near, LightId::Emitter(0));
+    let first = |g: &GuidingTree<&LightTree>, c| g.pmf_exact(c, &near, LightId::Emitter(0));
     assert!(
         first(&modulated, &b) > 3.0 * first(&plain, &a),
         "near light: {} vs {}",
@@ -1240,7 +1240,7 @@ fn modulation_reproduces_the_learned_cut_at_the_anchor_and_follows_importance() 
     );
     // And it samples the near point's inverse-square contributions with a
     // lower second moment, sum c^2 / p.
-    let m2 = |g: &GuidingTree<LightTree>, c| {
+    let m2 = |g: &GuidingTree<&LightTree>, c| {
         (0..32u32)
             .map(|i| {
                 let d2 = (lights[i as usize].bounds.center() - near.position).length_squared();

@@ -16,8 +16,8 @@ use common::{Rand, scene, two_rooms, value};
 
 /// Trains `glt` for `iterations` iterations of `per_iteration` jittered
 /// splats, sampling lights from the GLT itself as a renderer would.
-fn train(
-    glt: &mut Glt<'_, LightTree>,
+fn train<H: LightHierarchy>(
+    glt: &mut Glt<H>,
     lights: &[Emitter],
     rng: &mut Rand,
     iterations: usize,
@@ -374,4 +374,41 @@ fn memory_report_adds_up() {
         m.spatial_bytes + m.shared_bytes + m.cuts.node_bytes + m.cuts.sum_bytes
     );
     assert!(m.bytes_per_cell() > 0.0);
+}
+
+/// A renderer keeps its lights and its guiding state in one struct: the GLT
+/// owns its light tree or shares it through `Arc`, and samples exactly as a
+/// GLT borrowing the same tree does.
+#[test]
+fn owns_or_shares_its_light_tree() {
+    use std::sync::Arc;
+    struct Renderer {
+        lights: Arc<LightTree>,
+        guide: Glt<Arc<LightTree>>,
+        owned: Glt<LightTree>,
+    }
+    fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<Renderer>();
+    let lights = two_rooms();
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let shared = Arc::new(tree.clone());
+    let mut r = Renderer {
+        lights: shared.clone(),
+        guide: Glt::new(shared, scene(), small_config()).unwrap(),
+        owned: Glt::new(tree.clone(), scene(), small_config()).unwrap(),
+    };
+    let mut borrowed = Glt::new(&tree, scene(), small_config()).unwrap();
+    let (mut a, mut b, mut c) = (Rand::new(3), Rand::new(3), Rand::new(3));
+    train(&mut r.guide, &lights, &mut a, 3, 2000);
+    train(&mut r.owned, &lights, &mut b, 3, 2000);
+    train(&mut borrowed, &lights, &mut c, 3, 2000);
+    assert_eq!(r.lights.emitter_count(), lights.len());
+    let mut rng = Rand::new(9);
+    for _ in 0..200 {
+        let ctx = ShadingContext::at(rng.point(9.5));
+        let u = rng.f();
+        let s = borrowed.sample(&ctx, u);
+        assert_eq!(r.guide.sample(&ctx, u), s);
+        assert_eq!(r.owned.sample(&ctx, u), s);
+    }
 }

@@ -1231,8 +1231,8 @@ fn samplers_are_sync_and_work_across_threads() {
     fn assert_sync<T: Sync + Send>() {}
     assert_sync::<UniformSampler>();
     assert_sync::<PowerSampler>();
-    assert_sync::<EnergyTreeSampler<'static, LightTree>>();
-    assert_sync::<ImportanceTreeSampler<'static, LightTree>>();
+    assert_sync::<EnergyTreeSampler<&'static LightTree>>();
+    assert_sync::<ImportanceTreeSampler<&'static LightTree>>();
     assert_sync::<WithEnvironment<PowerSampler>>();
 
     let emitters = fit_scene(200, 8);

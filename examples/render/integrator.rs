@@ -23,12 +23,12 @@ pub struct Guides<'a> {
     pub lights: &'a (dyn LightSampler + Sync),
     /// The Guiding Light Tree to splat direct-light estimates into (the same
     /// object as `lights` for GLT methods).
-    pub glt: Option<&'a Glt<'a, LightTree>>,
+    pub glt: Option<&'a Glt<&'a LightTree>>,
     /// The SD-tree that guides directions (`ppg`).
     pub sd_tree: Option<&'a SdTree>,
     /// The combined field (`ppg-glt`): guides directions and NEE with one
     /// lookup per vertex (the same object as `lights`).
-    pub field: Option<&'a GuidingField<'a, LightTree>>,
+    pub field: Option<&'a GuidingField<&'a LightTree>>,
     /// Whether to record training data this pass.
     pub train: bool,
     /// Light splats carry the full contribution `f cos Le w / p` instead of
@@ -38,7 +38,7 @@ pub struct Guides<'a> {
 
 /// The field's cell at a path vertex (`ppg-glt`): found once, it serves
 /// the vertex's queries and every record made there later.
-type Located<'a> = FieldVertex<'a, 'a, LightTree>;
+type Located<'a> = FieldVertex<'a, &'a LightTree>;
 
 /// One guided path vertex awaiting its SD-tree splat.
 #[derive(Clone, Copy, Debug)]
@@ -70,7 +70,7 @@ struct Vertex<'a> {
 #[derive(Clone, Copy)]
 enum DirGuide<'a> {
     Sd(&'a SdCell),
-    Field(FieldVertex<'a, 'a, LightTree>),
+    Field(FieldVertex<'a, &'a LightTree>),
 }
 
 impl DirGuide<'_> {

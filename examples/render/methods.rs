@@ -206,7 +206,7 @@ pub fn new_field<'a>(
     scene: &'a Scene,
     method: Method,
     params: &GuideParams,
-) -> Option<GuidingField<'a, LightTree>> {
+) -> Option<GuidingField<&'a LightTree>> {
     if !method.uses_field() {
         return None;
     }
@@ -226,7 +226,7 @@ pub fn new_glt<'a>(
     scene: &'a Scene,
     method: Method,
     params: &GuideParams,
-) -> Option<Glt<'a, LightTree>> {
+) -> Option<Glt<&'a LightTree>> {
     if !method.uses_glt() {
         return None;
     }

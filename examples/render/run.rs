@@ -132,11 +132,11 @@ struct Done {
 #[allow(dead_code)] // the `render` example reads none of them; `light_limit` does
 pub struct Trained<'a> {
     /// The Guiding Light Tree of `pt-glt`.
-    pub glt: Option<Glt<'a, LightTree>>,
+    pub glt: Option<Glt<&'a LightTree>>,
     /// The SD-tree of `ppg`.
     pub sd_tree: Option<SdTree>,
     /// The combined field of `ppg-glt`.
-    pub field: Option<GuidingField<'a, LightTree>>,
+    pub field: Option<GuidingField<&'a LightTree>>,
 }
 
 /// Renders `scene` with `method` within `settings.budget`.

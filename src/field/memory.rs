@@ -62,7 +62,7 @@ impl FieldMemory {
     }
 }
 
-impl<H: LightHierarchy + ?Sized> GuidingField<'_, H> {
+impl<H: LightHierarchy> GuidingField<H> {
     /// Bytes used, per structure.
     pub fn memory(&self) -> FieldMemory {
         FieldMemory {

@@ -117,23 +117,27 @@ use glam::Vec3;
 
 /// The paper's guiding field: one spatial tree whose cells hold an SD-tree
 /// cell and a guiding cut. See the [module docs](self).
+///
+/// `H` is the light hierarchy, held as the renderer chooses: owned
+/// (`GuidingField<LightTree>`), shared with the scene
+/// (`GuidingField<Arc<LightTree>>`) or borrowed (`GuidingField<&LightTree>`).
 #[derive(Debug)]
-pub struct GuidingField<'a, H: LightHierarchy + ?Sized> {
+pub struct GuidingField<H: LightHierarchy> {
     cells: BinaryTree<FieldCell>,
     /// The SD-tree's configuration, iteration count and drop counters.
     sd: SdState,
-    guide: GuidingTree<'a, H>,
+    guide: GuidingTree<H>,
     light_filter: SpatialFilter,
     light_dropped: Counter,
 }
 
-impl<'a, H: LightHierarchy + ?Sized> GuidingField<'a, H> {
+impl<H: LightHierarchy> GuidingField<H> {
     /// A field over the light hierarchy `lights` for shading points inside
     /// `scene` (the scene's geometry bounds; points outside are clamped
     /// onto the spatial tree's cube): one cell, with a uniform quadtree and
     /// the initial (energy prior) cut. Errors for empty or non-finite
     /// bounds.
-    pub fn new(lights: &'a H, scene: Aabb, config: FieldConfig) -> Result<Self, SpatialError> {
+    pub fn new(lights: H, scene: Aabb, config: FieldConfig) -> Result<Self, SpatialError> {
         let guide = GuidingTree::new(lights, config.cut);
         let sd = SdState::new(config.sd);
         let cell = FieldCell {
@@ -153,7 +157,7 @@ impl<'a, H: LightHierarchy + ?Sized> GuidingField<'a, H> {
     /// the root cube), through which all queries and records at `p` go.
     /// `None` for a non-finite `p`.
     #[inline]
-    pub fn vertex(&self, p: Vec3) -> Option<FieldVertex<'_, 'a, H>> {
+    pub fn vertex(&self, p: Vec3) -> Option<FieldVertex<'_, H>> {
         let at = self.cells.locate_with_bounds(p)?;
         Some(FieldVertex::new(self, p, at))
     }
@@ -199,12 +203,12 @@ impl<'a, H: LightHierarchy + ?Sized> GuidingField<'a, H> {
     }
 
     /// The light hierarchy.
-    pub fn light_tree(&self) -> &'a H {
+    pub fn light_tree(&self) -> &H {
         self.guide.tree()
     }
 
     /// The guiding tree every cell's cut is used through.
-    pub fn guiding_tree(&self) -> &GuidingTree<'a, H> {
+    pub fn guiding_tree(&self) -> &GuidingTree<H> {
         &self.guide
     }
 
@@ -276,7 +280,7 @@ impl<'a, H: LightHierarchy + ?Sized> GuidingField<'a, H> {
     }
 }
 
-impl<H: LightHierarchy + ?Sized> LightSampler for GuidingField<'_, H> {
+impl<H: LightHierarchy> LightSampler for GuidingField<H> {
     /// Locates the cell of `ctx.position`, then applies the GLT's sampling
     /// rule with its cut. `None` for a non-finite position.
     #[inline]

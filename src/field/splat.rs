@@ -9,7 +9,7 @@ use crate::spatial::{SpatialFilter, jitter_u64};
 use glam::Vec3;
 use rand_core::Rng;
 
-impl<H: LightHierarchy + ?Sized> GuidingField<'_, H> {
+impl<H: LightHierarchy> GuidingField<H> {
     /// PPG's record, exactly as [`SdTree::splat`](crate::sd_tree::SdTree::splat):
     /// `radiance / pdf` into the quadtree of the cell at `p` along `dir`,
     /// statistical weight 1, spread by the configured SD filters (`rng` is

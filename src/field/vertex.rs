@@ -22,24 +22,24 @@ use rand_core::Rng;
 /// `ctx.position` is; `ctx` only feeds the importance below the cut
 /// ([`BelowCut::Importance`](crate::glt::BelowCut::Importance)).
 #[derive(Debug)]
-pub struct FieldVertex<'f, 'a, H: LightHierarchy + ?Sized> {
-    field: &'f GuidingField<'a, H>,
+pub struct FieldVertex<'f, H: LightHierarchy> {
+    field: &'f GuidingField<H>,
     cell: &'f FieldCell,
     p: Vec3,
     at: (CellId, Aabb),
 }
 
-impl<H: LightHierarchy + ?Sized> Clone for FieldVertex<'_, '_, H> {
+impl<H: LightHierarchy> Clone for FieldVertex<'_, H> {
     fn clone(&self) -> Self {
         *self
     }
 }
 
-impl<H: LightHierarchy + ?Sized> Copy for FieldVertex<'_, '_, H> {}
+impl<H: LightHierarchy> Copy for FieldVertex<'_, H> {}
 
-impl<'f, 'a, H: LightHierarchy + ?Sized> FieldVertex<'f, 'a, H> {
+impl<'f, H: LightHierarchy> FieldVertex<'f, H> {
     #[inline]
-    pub(super) fn new(field: &'f GuidingField<'a, H>, p: Vec3, at: (CellId, Aabb)) -> Self {
+    pub(super) fn new(field: &'f GuidingField<H>, p: Vec3, at: (CellId, Aabb)) -> Self {
         Self {
             field,
             cell: field.cells.data(at.0),
@@ -155,7 +155,7 @@ impl<'f, 'a, H: LightHierarchy + ?Sized> FieldVertex<'f, 'a, H> {
     }
 }
 
-impl<H: LightHierarchy + ?Sized> LightSampler for FieldVertex<'_, '_, H> {
+impl<H: LightHierarchy> LightSampler for FieldVertex<'_, H> {
     /// Applies the GLT's sampling rule with the located cell's cut.
     #[inline]
     fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {

@@ -123,21 +123,25 @@ impl GltMemory {
 /// Per iteration a renderer samples lights with [`LightSampler::sample`]
 /// (any number of threads), splats the resulting direct-light estimates
 /// with [`Glt::splat`] (idem), then calls [`Glt::refine`] once.
+///
+/// `H` is the light hierarchy, held as the renderer chooses: owned
+/// (`Glt<LightTree>`), shared with the scene (`Glt<Arc<LightTree>>`) or
+/// borrowed (`Glt<&LightTree>`).
 #[derive(Debug)]
-pub struct Glt<'a, H: LightHierarchy + ?Sized> {
-    guide: GuidingTree<'a, H>,
+pub struct Glt<H: LightHierarchy> {
+    guide: GuidingTree<H>,
     config: GltConfig,
     spatial: BinaryTree<GltCell>,
     iteration: u32,
     dropped: Counter,
 }
 
-impl<'a, H: LightHierarchy + ?Sized> Glt<'a, H> {
+impl<H: LightHierarchy> Glt<H> {
     /// A GLT over the light hierarchy `tree` for shading points inside
     /// `scene` (the scene's geometry bounds; points outside are clamped
     /// onto the spatial tree's cube). One cell with the initial (energy
     /// prior) cut. Errors for empty or non-finite `scene`.
-    pub fn new(tree: &'a H, scene: Aabb, config: GltConfig) -> Result<Self, SpatialError> {
+    pub fn new(tree: H, scene: Aabb, config: GltConfig) -> Result<Self, SpatialError> {
         let mut config = config;
         config.cut = config.cut.sanitized();
         if config.spatial_threshold.is_nan() || config.spatial_threshold < 0.0 {
@@ -159,12 +163,12 @@ impl<'a, H: LightHierarchy + ?Sized> Glt<'a, H> {
     }
 
     /// The light hierarchy.
-    pub fn tree(&self) -> &'a H {
+    pub fn tree(&self) -> &H {
         self.guide.tree()
     }
 
     /// The guiding tree every cell's cut is used through.
-    pub fn guiding_tree(&self) -> &GuidingTree<'a, H> {
+    pub fn guiding_tree(&self) -> &GuidingTree<H> {
         &self.guide
     }
 
@@ -319,7 +323,7 @@ impl core::iter::Sum for CutMemory {
     }
 }
 
-impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
+impl<H: LightHierarchy> GuidingTree<H> {
     /// Records the direct-light estimate `value` for `light` made at a point
     /// into the cuts of the cells of `cells` that `filter` spreads the point
     /// over (each cell's part `value * weight`), through
@@ -361,7 +365,7 @@ impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
     }
 }
 
-impl<H: LightHierarchy + ?Sized> LightSampler for Glt<'_, H> {
+impl<H: LightHierarchy> LightSampler for Glt<H> {
     /// Locates the cell of `ctx.position`, then applies the GLT's sampling
     /// rule with its cut. `None` for a non-finite position.
     #[inline]

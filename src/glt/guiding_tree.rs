@@ -27,8 +27,8 @@ use alloc::vec::Vec;
 /// any positive energy gets a positive probability (at least the smallest
 /// `f32`); both children dark is NaN (neither can be chosen).
 #[derive(Clone, Debug)]
-pub struct GuidingTree<'a, H: LightHierarchy + ?Sized> {
-    tree: &'a H,
+pub struct GuidingTree<H: LightHierarchy> {
+    tree: H,
     split: Vec<f32>,
     walk: WalkTable,
     /// Every node decoded for the importance-based rules; built only when
@@ -74,35 +74,39 @@ pub(crate) fn decode_split(s: f32) -> Option<(f64, f64)> {
     Some((left, right))
 }
 
-impl<'a, H: LightHierarchy + ?Sized> GuidingTree<'a, H> {
+impl<H: LightHierarchy> GuidingTree<H> {
     /// Prepares `tree` for guiding with `config` (sanitized, see
     /// [`CutConfig::sanitized`]). O(nodes).
-    pub fn new(tree: &'a H, config: CutConfig) -> Self {
-        let split: Vec<f32> = (0..tree.node_count() as u32)
-            .map(|n| match tree.children(n) {
-                Some([l, r]) => encode_split(tree.energy(l), tree.energy(r)),
+    pub fn new(tree: H, config: CutConfig) -> Self {
+        let lights = &tree;
+        let split: Vec<f32> = (0..lights.node_count() as u32)
+            .map(|n| match lights.children(n) {
+                Some([l, r]) => encode_split(lights.energy(l), lights.energy(r)),
                 None => f32::NAN,
             })
             .collect();
-        let walk = WalkTable::new(tree, |n| split.get(n as usize).copied().unwrap_or(f32::NAN));
+        let walk = WalkTable::new(lights, |n| {
+            split.get(n as usize).copied().unwrap_or(f32::NAN)
+        });
         let config = config.sanitized();
         let importance = config
             .uses_importance()
-            .then(|| ImportanceTable::new(tree, WalkTable::pair_nodes(tree).into_iter()));
+            .then(|| ImportanceTable::new(lights, WalkTable::pair_nodes(lights).into_iter()));
+        let has_energy = lights.root().is_some_and(|r| lights.energy(r) > 0.0);
         Self {
             tree,
             split,
             walk,
             importance,
             config,
-            has_energy: tree.root().is_some_and(|r| tree.energy(r) > 0.0),
+            has_energy,
         }
     }
 
     /// The light hierarchy.
     #[inline]
-    pub fn tree(&self) -> &'a H {
-        self.tree
+    pub fn tree(&self) -> &H {
+        &self.tree
     }
 
     /// The (sanitized) configuration.
@@ -163,6 +167,6 @@ impl<'a, H: LightHierarchy + ?Sized> GuidingTree<'a, H> {
     /// empty) gets the empty cut. The environment fraction starts at its
     /// prior.
     pub fn new_cut(&self) -> GuidingCut {
-        GuidingCut::new(self.tree, &self.config)
+        GuidingCut::new(&self.tree, &self.config)
     }
 }

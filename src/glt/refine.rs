@@ -28,7 +28,7 @@ struct Task {
     old: Option<u32>,
 }
 
-impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
+impl<H: LightHierarchy> GuidingTree<H> {
     /// Rebuilds `cut`'s sampled copy from the accumulated sums, then zeroes them
     /// (swapping the two copies). Returns false when the cell collected
     /// nothing from emitters: then the cut is kept as it was. A cut that
@@ -167,8 +167,8 @@ fn stored_p_left(weights: (f64, f64), importances: Option<(f64, f64)>) -> f32 {
     }
 }
 
-fn rebuild<H: LightHierarchy + ?Sized>(
-    guide: &GuidingTree<'_, H>,
+fn rebuild<H: LightHierarchy>(
+    guide: &GuidingTree<H>,
     old: &[CutNode],
     sums: &[f64],
     total: f64,

@@ -133,9 +133,9 @@ fn pick((pl, pr): (f64, f64), side: Side) -> f64 {
 
 /// Everything one query needs: the guiding tree, the cell's cut nodes, the
 /// rule below the cut and the shading point.
-pub(crate) struct Rule<'a, 'b, H: LightHierarchy + ?Sized> {
-    guide: &'b GuidingTree<'a, H>,
-    tree: &'a H,
+pub(crate) struct Rule<'b, H: LightHierarchy> {
+    guide: &'b GuidingTree<H>,
+    tree: &'b H,
     nodes: &'b [CutNode],
     below: BelowCut,
     /// Whether the cut's probabilities follow the importance at the
@@ -154,11 +154,11 @@ pub(crate) struct Rule<'a, 'b, H: LightHierarchy + ?Sized> {
     mixture: Mixture,
 }
 
-impl<'a, 'b, H: LightHierarchy + ?Sized> Rule<'a, 'b, H> {
+impl<'b, H: LightHierarchy> Rule<'b, H> {
     /// The rule for `cut` at `ctx`.
     #[inline]
     pub(crate) fn new(
-        guide: &'b GuidingTree<'a, H>,
+        guide: &'b GuidingTree<H>,
         cut: &'b GuidingCut,
         ctx: &'b ShadingContext,
     ) -> Self {
@@ -378,7 +378,7 @@ pub(crate) fn to_light_sample(s: Option<(LightId, f64)>) -> Option<LightSample> 
     (pmf > 0.0).then_some(LightSample { light, pmf })
 }
 
-impl<'a, H: LightHierarchy + ?Sized> GuidingTree<'a, H> {
+impl<H: LightHierarchy> GuidingTree<H> {
     /// Chooses a light for a shading point `ctx` in the cell of `cut` from
     /// one uniform number `u` in `[0, 1)`, by the GLT's sampling rule:
     ///
@@ -426,27 +426,27 @@ impl<'a, H: LightHierarchy + ?Sized> GuidingTree<'a, H> {
 
     /// `cut` as a [`LightSampler`] (for one cell, or a renderer that keeps
     /// its own spatial structure).
-    pub fn sampler<'b>(&'b self, cut: &'b GuidingCut) -> CutSampler<'a, 'b, H> {
+    pub fn sampler<'b>(&'b self, cut: &'b GuidingCut) -> CutSampler<'b, H> {
         CutSampler { guide: self, cut }
     }
 }
 
 /// One cell's cut with its [`GuidingTree`], as a [`LightSampler`].
 #[derive(Debug)]
-pub struct CutSampler<'a, 'b, H: LightHierarchy + ?Sized> {
-    guide: &'b GuidingTree<'a, H>,
+pub struct CutSampler<'b, H: LightHierarchy> {
+    guide: &'b GuidingTree<H>,
     cut: &'b GuidingCut,
 }
 
-impl<H: LightHierarchy + ?Sized> Clone for CutSampler<'_, '_, H> {
+impl<H: LightHierarchy> Clone for CutSampler<'_, H> {
     fn clone(&self) -> Self {
         *self
     }
 }
 
-impl<H: LightHierarchy + ?Sized> Copy for CutSampler<'_, '_, H> {}
+impl<H: LightHierarchy> Copy for CutSampler<'_, H> {}
 
-impl<H: LightHierarchy + ?Sized> LightSampler for CutSampler<'_, '_, H> {
+impl<H: LightHierarchy> LightSampler for CutSampler<'_, H> {
     #[inline]
     fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
         self.guide.sample(self.cut, ctx, u)
@@ -462,7 +462,7 @@ impl<H: LightHierarchy + ?Sized> LightSampler for CutSampler<'_, '_, H> {
     }
 }
 
-impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
+impl<H: LightHierarchy> GuidingTree<H> {
     /// True when nothing can ever be sampled: no emitter has power and
     /// there is no environment light with a positive probability.
     pub fn is_empty(&self) -> bool {

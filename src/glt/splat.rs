@@ -53,7 +53,7 @@ impl GuidingCut {
     }
 }
 
-impl<H: LightHierarchy + ?Sized> GuidingTree<'_, H> {
+impl<H: LightHierarchy> GuidingTree<H> {
     /// Records into `cut` `value`, the MIS-weighted direct-light estimate for `light`
     /// seen from a point of this cell, without BSDF and cosine: from NEE,
     /// `Le * T * w_mis / (pdf_solid_angle * pmf)`; from a BSDF-sampled

@@ -17,44 +17,36 @@ use crate::light_tree::descend::energy_weights;
 /// root-to-leaf path with the same arithmetic, so both agree bit for bit. A zero-energy subtree is never
 /// entered; when the root has no energy nothing is sampled. O(depth) per
 /// call.
-#[derive(Debug)]
-pub struct EnergyTreeSampler<'a, H: LightHierarchy + ?Sized> {
-    tree: &'a H,
+#[derive(Clone, Copy, Debug)]
+pub struct EnergyTreeSampler<H: LightHierarchy> {
+    tree: H,
 }
 
-impl<H: LightHierarchy + ?Sized> Clone for EnergyTreeSampler<'_, H> {
-    fn clone(&self) -> Self {
-        *self
-    }
-}
-
-impl<H: LightHierarchy + ?Sized> Copy for EnergyTreeSampler<'_, H> {}
-
-impl<'a, H: LightHierarchy + ?Sized> EnergyTreeSampler<'a, H> {
+impl<H: LightHierarchy> EnergyTreeSampler<H> {
     /// A sampler over `tree`'s emitters.
-    pub fn new(tree: &'a H) -> Self {
+    pub fn new(tree: H) -> Self {
         Self { tree }
     }
 
     /// The hierarchy it descends.
-    pub fn tree(&self) -> &'a H {
-        self.tree
+    pub fn tree(&self) -> &H {
+        &self.tree
     }
 }
 
-impl<H: LightHierarchy + ?Sized> LightSampler for EnergyTreeSampler<'_, H> {
+impl<H: LightHierarchy> LightSampler for EnergyTreeSampler<H> {
     #[inline]
     fn sample(&self, _ctx: &ShadingContext, u: f32) -> Option<LightSample> {
-        tree_walk::sample(self.tree, u, energy_weights(self.tree))
+        tree_walk::sample(&self.tree, u, energy_weights(&self.tree))
     }
 
     #[inline]
     fn pmf(&self, _ctx: &ShadingContext, light: LightId) -> f32 {
-        tree_walk::pmf(self.tree, light, energy_weights(self.tree))
+        tree_walk::pmf(&self.tree, light, energy_weights(&self.tree))
     }
 
     #[inline]
     fn is_empty(&self) -> bool {
-        tree_walk::live_root(self.tree).is_none()
+        tree_walk::live_root(&self.tree).is_none()
     }
 }

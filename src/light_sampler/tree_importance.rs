@@ -24,28 +24,20 @@ use crate::math::Descent;
 /// replays the emitter's path with the same weights, so sampled and
 /// evaluated pmfs agree bit for bit. O(depth) importance evaluations (two per
 /// level) per call.
-#[derive(Debug)]
-pub struct ImportanceTreeSampler<'a, H: LightHierarchy + ?Sized> {
-    tree: &'a H,
+#[derive(Clone, Copy, Debug)]
+pub struct ImportanceTreeSampler<H: LightHierarchy> {
+    tree: H,
 }
 
-impl<H: LightHierarchy + ?Sized> Clone for ImportanceTreeSampler<'_, H> {
-    fn clone(&self) -> Self {
-        *self
-    }
-}
-
-impl<H: LightHierarchy + ?Sized> Copy for ImportanceTreeSampler<'_, H> {}
-
-impl<'a, H: LightHierarchy + ?Sized> ImportanceTreeSampler<'a, H> {
+impl<H: LightHierarchy> ImportanceTreeSampler<H> {
     /// A sampler over `tree`'s emitters.
-    pub fn new(tree: &'a H) -> Self {
+    pub fn new(tree: H) -> Self {
         Self { tree }
     }
 
     /// The hierarchy it descends.
-    pub fn tree(&self) -> &'a H {
-        self.tree
+    pub fn tree(&self) -> &H {
+        &self.tree
     }
 
     /// The descent weights of children `l` and `r` at `ctx`: their
@@ -66,19 +58,19 @@ impl<'a, H: LightHierarchy + ?Sized> ImportanceTreeSampler<'a, H> {
     }
 }
 
-impl<H: LightHierarchy + ?Sized> LightSampler for ImportanceTreeSampler<'_, H> {
+impl<H: LightHierarchy> LightSampler for ImportanceTreeSampler<H> {
     #[inline]
     fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
-        tree_walk::sample(self.tree, u, self.weights(ctx))
+        tree_walk::sample(&self.tree, u, self.weights(ctx))
     }
 
     #[inline]
     fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        tree_walk::pmf(self.tree, light, self.weights(ctx))
+        tree_walk::pmf(&self.tree, light, self.weights(ctx))
     }
 
     #[inline]
     fn is_empty(&self) -> bool {
-        tree_walk::live_root(self.tree).is_none()
+        tree_walk::live_root(&self.tree).is_none()
     }
 }

@@ -68,3 +68,61 @@ pub trait LightHierarchy {
         Some(path)
     }
 }
+
+/// A shared or borrowed hierarchy is a hierarchy: the guiding structures own
+/// their light tree through any of these, so a renderer chooses between
+/// `Glt<LightTree>` (owned), `Glt<Arc<LightTree>>` (shared with the scene)
+/// and `Glt<&LightTree>` (borrowed).
+macro_rules! forward_hierarchy {
+    ($($ptr:ty),*) => {$(
+        impl<T: LightHierarchy + ?Sized> LightHierarchy for $ptr {
+            #[inline(always)]
+            fn root(&self) -> Option<u32> {
+                (**self).root()
+            }
+            #[inline(always)]
+            fn children(&self, node: u32) -> Option<[u32; 2]> {
+                (**self).children(node)
+            }
+            #[inline(always)]
+            fn parent(&self, node: u32) -> Option<u32> {
+                (**self).parent(node)
+            }
+            #[inline(always)]
+            fn energy(&self, node: u32) -> f32 {
+                (**self).energy(node)
+            }
+            #[inline(always)]
+            fn node_bounds(&self, node: u32) -> NodeBounds {
+                (**self).node_bounds(node)
+            }
+            #[inline(always)]
+            fn emitter(&self, node: u32) -> Option<u32> {
+                (**self).emitter(node)
+            }
+            #[inline(always)]
+            fn leaf(&self, emitter: u32) -> Option<u32> {
+                (**self).leaf(emitter)
+            }
+            #[inline(always)]
+            fn node_count(&self) -> usize {
+                (**self).node_count()
+            }
+            #[inline(always)]
+            fn emitter_count(&self) -> usize {
+                (**self).emitter_count()
+            }
+            #[inline(always)]
+            fn path(&self, emitter: u32) -> Option<EmitterPath> {
+                (**self).path(emitter)
+            }
+        }
+    )*};
+}
+
+forward_hierarchy!(
+    &T,
+    alloc::boxed::Box<T>,
+    alloc::rc::Rc<T>,
+    alloc::sync::Arc<T>
+);
