@@ -143,7 +143,7 @@ fn bench_sampling(c: &mut Criterion) {
         // same leaves, so the same path lengths; the ratio to `energy` is
         // the rule's own overhead. Trained cuts choose other (often deeper)
         // leaves, which costs more for any sampler.
-        let fresh_guide = GuidingTree::new(&tree, CutConfig::default());
+        let fresh_guide = GuidingTree::new(&tree, CutConfig::default()).unwrap();
         let fresh = fresh_guide.new_cut();
         group.bench_function("cut-untrained/sample+pmf", |b| {
             b.iter(|| {
@@ -170,7 +170,7 @@ fn bench_sampling(c: &mut Criterion) {
                 sigma,
                 ..CutConfig::default()
             };
-            let guide = GuidingTree::new(&tree, config);
+            let guide = GuidingTree::new(&tree, config).unwrap();
             let cut = trained_cut(&lights, &guide);
             let sampled: Vec<LightId> = u
                 .iter()
@@ -240,7 +240,7 @@ fn bench_sampling(c: &mut Criterion) {
                     },
                 ),
             ] {
-                let guide = GuidingTree::new(&tree, config);
+                let guide = GuidingTree::new(&tree, config).unwrap();
                 let cut = trained_cut(&lights, &guide);
                 group.bench_function(name, |b| {
                     b.iter(|| {
@@ -299,7 +299,7 @@ fn bench_sampling(c: &mut Criterion) {
                 })
             });
             let config = CutConfig::default();
-            let guide = GuidingTree::new(&tree, config);
+            let guide = GuidingTree::new(&tree, config).unwrap();
             let cut = trained_cut(&lights, &guide);
             group.bench_function("cut/splat", |b| {
                 b.iter(|| {
@@ -316,7 +316,7 @@ fn bench_sampling(c: &mut Criterion) {
                 sigma,
                 ..CutConfig::default()
             };
-            let guide = GuidingTree::new(&tree, config);
+            let guide = GuidingTree::new(&tree, config).unwrap();
             // A trained cut holding one iteration's sums.
             let cut = trained_cut(&lights, &guide);
             let mut rng = Rand::new(5);

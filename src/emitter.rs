@@ -158,4 +158,14 @@ impl ShadingContext {
             normal: normal.try_normalize(),
         }
     }
+
+    /// Whether the position is finite. Every [`LightSampler`] chooses
+    /// nothing at a non-finite position: `sample` is `None` and every
+    /// `pmf` is 0. (A zero or non-finite normal counts as no normal.)
+    ///
+    /// [`LightSampler`]: crate::LightSampler
+    #[inline]
+    pub fn is_finite(&self) -> bool {
+        self.position.is_finite()
+    }
 }

@@ -82,6 +82,7 @@
 extern crate alloc;
 
 pub mod emitter;
+pub mod error;
 pub mod field;
 pub mod glt;
 pub mod light_sampler;
@@ -101,6 +102,7 @@ pub use glam;
 pub use rand_core;
 
 pub use emitter::{Emitter, Emitters, ShadingContext};
+pub use error::{ConfigError, Error};
 pub use light_sampler::{
     EnergyTreeSampler, ImportanceTreeSampler, LightId, LightSample, LightSampler, PowerSampler,
     UniformSampler, WithEnvironment,

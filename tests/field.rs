@@ -35,7 +35,7 @@ fn rooms() -> (Vec<Emitter>, LightTree) {
 }
 
 /// `sd` with spatial threshold `c`.
-fn sd_with(c: f32, sd: SdTreeConfig) -> SdTreeConfig {
+fn sd_with(c: f64, sd: SdTreeConfig) -> SdTreeConfig {
     SdTreeConfig {
         spatial_threshold: c,
         ..sd
@@ -43,7 +43,7 @@ fn sd_with(c: f32, sd: SdTreeConfig) -> SdTreeConfig {
 }
 
 /// Field defaults with the SD-tree's `sd` at spatial threshold `c`.
-fn config_with(c: f32, sd: SdTreeConfig) -> FieldConfig {
+fn config_with(c: f64, sd: SdTreeConfig) -> FieldConfig {
     FieldConfig {
         sd: sd_with(c, sd),
         ..FieldConfig::default()
@@ -109,7 +109,7 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
     };
     let mut field = GuidingField::new(&tree, scene(), config).unwrap();
     let mut sd = SdTree::new(scene(), sd_config).unwrap();
-    let guide = GuidingTree::new(&tree, config.cut);
+    let guide = GuidingTree::new(&tree, config.cut).unwrap();
     let mut cuts = vec![guide.new_cut()];
     let mut rng = Rand::seeded(1);
     let mut learned = false;

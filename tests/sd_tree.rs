@@ -49,14 +49,14 @@ fn train(tree: &SdTree, n: usize, seed: u64) {
     }
 }
 
-fn config(c: f32) -> SdTreeConfig {
+fn config(c: f64) -> SdTreeConfig {
     SdTreeConfig {
         spatial_threshold: c,
         ..SdTreeConfig::default()
     }
 }
 
-fn trained(c: f32) -> SdTree {
+fn trained(c: f64) -> SdTree {
     let mut t = SdTree::new(scene(), config(c)).unwrap();
     for it in 0..4 {
         train(&t, 4000, it);

@@ -196,7 +196,7 @@ fn cut_config(scene: &Scene, params: &GuideParams) -> CutConfig {
 /// threshold.
 fn sd_config(params: &GuideParams) -> SdTreeConfig {
     SdTreeConfig {
-        spatial_threshold: params.spatial_threshold as f32,
+        spatial_threshold: params.spatial_threshold,
         ..SdTreeConfig::improved()
     }
 }

@@ -17,7 +17,7 @@ pub struct FieldConfig {
     /// its `max_bytes` caps everything but the table the cells share
     /// ([`FieldMemory::capped`](super::FieldMemory::capped)).
     pub sd: SdTreeConfig,
-    /// Every cell's cut (sanitized, see [`CutConfig::sanitized`]).
+    /// Every cell's cut.
     pub cut: CutConfig,
     /// The spatial filter of
     /// [`GuidingField::splat_light`](super::GuidingField::splat_light).
@@ -42,6 +42,13 @@ impl Default for FieldConfig {
 }
 
 impl FieldConfig {
+    /// Checks the SD-tree's ([`SdTreeConfig::validate`]) and the cuts'
+    /// ([`CutConfig::validate`]) fields.
+    pub fn validate(&self) -> Result<(), crate::ConfigError> {
+        self.sd.validate()?;
+        self.cut.validate()
+    }
+
     /// The configuration with both the SD-tree's and the cuts' training
     /// sums in `mode` ([`Accumulation::Deterministic`] makes the whole
     /// learned field bit-identical whatever the thread count).

@@ -107,12 +107,13 @@ pub use memory::FieldMemory;
 pub use vertex::FieldVertex;
 
 use crate::emitter::ShadingContext;
+use crate::error::Error;
 use crate::glt::{GuidingTree, SplatOutcome};
 use crate::light_sampler::{LightId, LightSample, LightSampler};
 use crate::light_tree::LightHierarchy;
 use crate::math::{Aabb, Counter};
 use crate::sd_tree::{DroppedSplats, SdState};
-use crate::spatial::{BinaryTree, CellId, RefineOutcome, SpatialError, SpatialFilter, SpatialTree};
+use crate::spatial::{BinaryTree, CellId, RefineOutcome, SpatialFilter, SpatialTree};
 use glam::Vec3;
 
 /// The paper's guiding field: one spatial tree whose cells hold an SD-tree
@@ -136,9 +137,11 @@ impl<H: LightHierarchy> GuidingField<H> {
     /// `scene` (the scene's geometry bounds; points outside are clamped
     /// onto the spatial tree's cube): one cell, with a uniform quadtree and
     /// the initial (energy prior) cut. Errors for empty or non-finite
-    /// bounds.
-    pub fn new(lights: H, scene: Aabb, config: FieldConfig) -> Result<Self, SpatialError> {
-        let guide = GuidingTree::new(lights, config.cut);
+    /// bounds, and for an invalid configuration
+    /// ([`FieldConfig::validate`]).
+    pub fn new(lights: H, scene: Aabb, config: FieldConfig) -> Result<Self, Error> {
+        config.validate()?;
+        let guide = GuidingTree::new(lights, config.cut)?;
         let sd = SdState::new(config.sd);
         let cell = FieldCell {
             sd: sd.new_cell(),
@@ -193,7 +196,7 @@ impl<H: LightHierarchy> GuidingField<H> {
         )
     }
 
-    /// The configuration (the cuts' sanitized).
+    /// The configuration.
     pub fn config(&self) -> FieldConfig {
         FieldConfig {
             sd: self.sd.config,

@@ -1,5 +1,6 @@
 //! Parameters of the Guiding Light Tree: the per-cell cut ([`CutConfig`]).
 
+use crate::error::{self, ConfigError};
 use crate::math::Accumulation;
 
 /// How the cut's sampling continues below the cut, inside the cluster a cut
@@ -104,9 +105,8 @@ pub enum SplitPrior {
 
 /// The parameters of one guiding cut: how it is refined and sampled.
 ///
-/// Out-of-range values are not errors: `sigma` is clamped to `[0, 1]`,
-/// `alpha` and the environment probability to `[0, 1]`, and NaN falls back
-/// to the default (see [`CutConfig::sanitized`]).
+/// Constructors check it ([`CutConfig::validate`]): a value out of its
+/// range is a [`ConfigError`], never clamped.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CutConfig {
     /// Split threshold: a slot whose share of its cell's learned total is
@@ -221,22 +221,20 @@ impl CutConfig {
             || self.prior == Prior::Importance
     }
 
-    /// The configuration with every number clamped into its range (NaN
-    /// replaced by the default). The cut code only ever uses this form.
-    pub fn sanitized(&self) -> Self {
-        let d = Self::default();
-        let unit = |x: f64, default: f64| {
-            if x.is_nan() {
-                default
-            } else {
-                x.clamp(0.0, 1.0)
-            }
-        };
-        Self {
-            sigma: unit(self.sigma, d.sigma),
-            alpha: unit(self.alpha, d.alpha),
-            environment: self.environment.map(|q| unit(q, 0.0)),
-            ..*self
+    /// Checks every field: `sigma` and `alpha` in `[0, 1]`, the
+    /// environment's prior probability in `[0, 1)` (at 1 no emitter could
+    /// ever be sampled).
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        error::unit("CutConfig::sigma", self.sigma)?;
+        error::unit("CutConfig::alpha", self.alpha)?;
+        if let Some(q) = self.environment {
+            error::check(
+                "CutConfig::environment",
+                q,
+                (0.0..1.0).contains(&q),
+                "in [0, 1)",
+            )?;
         }
+        Ok(())
     }
 }

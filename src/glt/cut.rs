@@ -121,7 +121,6 @@ impl core::ops::AddAssign for CutMemory {
 impl GuidingCut {
     /// The initial cut (see [`GuidingTree::new_cut`](super::GuidingTree::new_cut)).
     pub(crate) fn new<H: LightHierarchy + ?Sized>(tree: &H, config: &CutConfig) -> Self {
-        let config = config.sanitized();
         // Modulated, a cut that has learned nothing has equal factors on
         // both sides, so it samples by the importance at the shading point
         // (a dark side still gets nothing); else by the energy prior.
@@ -145,7 +144,7 @@ impl GuidingCut {
             sums,
             env_fraction: config.environment.unwrap_or(0.0) as f32,
             recorded: Counter::new(),
-            anchor: SumBuffer::new(anchor_sums(&config), config.accumulation),
+            anchor: SumBuffer::new(anchor_sums(config), config.accumulation),
             modulated,
         }
     }

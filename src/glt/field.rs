@@ -8,13 +8,12 @@ use super::cut_node::CutNode;
 use super::guiding_tree::GuidingTree;
 use super::splat::SplatOutcome;
 use crate::emitter::ShadingContext;
+use crate::error::{ConfigError, Error};
 use crate::light_sampler::{LightId, LightSample, LightSampler};
 use crate::light_tree::LightHierarchy;
 use crate::math::pmf_to_f32;
 use crate::math::{Aabb, Counter};
-use crate::spatial::{
-    BinaryTree, CellId, SpatialError, SpatialFilter, SpatialTree, jitter_u64, split_threshold,
-};
+use crate::spatial::{BinaryTree, CellId, SpatialFilter, SpatialTree, jitter_u64, split_threshold};
 use glam::Vec3;
 use rand_core::Rng;
 
@@ -39,6 +38,16 @@ pub struct GltConfig {
     /// neighbours' lights and samples worse than without learning
     /// (`tests/glt_walls.rs`).
     pub filter: SpatialFilter,
+}
+
+impl GltConfig {
+    /// Checks every field: the cut's ([`CutConfig::validate`]) and
+    /// `spatial_threshold` finite and positive (at 0 every cell would
+    /// split on every splat).
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        self.cut.validate()?;
+        crate::error::positive("GltConfig::spatial_threshold", self.spatial_threshold)
+    }
 }
 
 impl Default for GltConfig {
@@ -139,15 +148,12 @@ pub struct Glt<H: LightHierarchy> {
 impl<H: LightHierarchy> Glt<H> {
     /// A GLT over the light hierarchy `tree` for shading points inside
     /// `scene` (the scene's geometry bounds; points outside are clamped
-    /// onto the spatial tree's cube). One cell with the initial (energy
-    /// prior) cut. Errors for empty or non-finite `scene`.
-    pub fn new(tree: H, scene: Aabb, config: GltConfig) -> Result<Self, SpatialError> {
-        let mut config = config;
-        config.cut = config.cut.sanitized();
-        if config.spatial_threshold.is_nan() || config.spatial_threshold < 0.0 {
-            config.spatial_threshold = GltConfig::default().spatial_threshold;
-        }
-        let guide = GuidingTree::new(tree, config.cut);
+    /// onto the spatial tree's cube). One cell with the initial cut.
+    /// Errors for an invalid configuration ([`GltConfig::validate`]) and
+    /// for empty or non-finite `scene`.
+    pub fn new(tree: H, scene: Aabb, config: GltConfig) -> Result<Self, Error> {
+        config.validate()?;
+        let guide = GuidingTree::new(tree, config.cut)?;
         let cell = GltCell {
             cut: guide.new_cut(),
             splats: Counter::new(),
@@ -172,7 +178,7 @@ impl<H: LightHierarchy> Glt<H> {
         &self.guide
     }
 
-    /// The configuration (sanitized).
+    /// The configuration.
     pub fn config(&self) -> &GltConfig {
         &self.config
     }

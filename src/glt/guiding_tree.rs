@@ -4,6 +4,7 @@
 use super::config::CutConfig;
 use super::cut::GuidingCut;
 use super::walk::WalkTable;
+use crate::error::ConfigError;
 use crate::light_sampler::ImportanceTable;
 use crate::light_tree::LightHierarchy;
 use crate::math::Descent;
@@ -75,9 +76,10 @@ pub(crate) fn decode_split(s: f32) -> Option<(f64, f64)> {
 }
 
 impl<H: LightHierarchy> GuidingTree<H> {
-    /// Prepares `tree` for guiding with `config` (sanitized, see
-    /// [`CutConfig::sanitized`]). O(nodes).
-    pub fn new(tree: H, config: CutConfig) -> Self {
+    /// Prepares `tree` for guiding with `config`. O(nodes). Errors for an
+    /// invalid configuration ([`CutConfig::validate`]).
+    pub fn new(tree: H, config: CutConfig) -> Result<Self, ConfigError> {
+        config.validate()?;
         let lights = &tree;
         let split: Vec<f32> = (0..lights.node_count() as u32)
             .map(|n| match lights.children(n) {
@@ -88,19 +90,18 @@ impl<H: LightHierarchy> GuidingTree<H> {
         let walk = WalkTable::new(lights, |n| {
             split.get(n as usize).copied().unwrap_or(f32::NAN)
         });
-        let config = config.sanitized();
         let importance = config
             .uses_importance()
             .then(|| ImportanceTable::new(lights, WalkTable::pair_nodes(lights).into_iter()));
         let has_energy = lights.root().is_some_and(|r| lights.energy(r) > 0.0);
-        Self {
+        Ok(Self {
             tree,
             split,
             walk,
             importance,
             config,
             has_energy,
-        }
+        })
     }
 
     /// The light hierarchy.
@@ -109,7 +110,7 @@ impl<H: LightHierarchy> GuidingTree<H> {
         &self.tree
     }
 
-    /// The (sanitized) configuration.
+    /// The configuration.
     #[inline]
     pub fn config(&self) -> &CutConfig {
         &self.config

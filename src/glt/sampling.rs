@@ -52,7 +52,7 @@ pub(crate) struct Mixture {
 }
 
 impl Mixture {
-    /// The mixture for `cut` under a sanitized `config`. Emitters get
+    /// The mixture for `cut` under a validated `config`. Emitters get
     /// nothing when the light tree has no energy at all (then the
     /// environment, if any, gets everything).
     #[inline]
@@ -395,7 +395,7 @@ impl<H: LightHierarchy> GuidingTree<H> {
     /// nothing can be chosen or the pmf rounds to zero in `f32`.
     #[inline]
     pub fn sample(&self, cut: &GuidingCut, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
-        to_light_sample(Rule::new(self, cut, ctx).sample(Descent::new(u)))
+        to_light_sample(self.sample_exact_from(cut, ctx, Descent::new(u)))
     }
 
     /// Like [`GuidingTree::sample`] from an `f64` number (53 bits),
@@ -408,7 +408,21 @@ impl<H: LightHierarchy> GuidingTree<H> {
         ctx: &ShadingContext,
         u: f64,
     ) -> Option<(LightId, f64)> {
-        Rule::new(self, cut, ctx).sample(Descent::from_f64(u))
+        self.sample_exact_from(cut, ctx, Descent::from_f64(u))
+    }
+
+    /// The walk from descent `d`; nothing at a non-finite position.
+    #[inline(always)]
+    fn sample_exact_from(
+        &self,
+        cut: &GuidingCut,
+        ctx: &ShadingContext,
+        d: Descent,
+    ) -> Option<(LightId, f64)> {
+        if !ctx.is_finite() {
+            return None;
+        }
+        Rule::new(self, cut, ctx).sample(d)
     }
 
     /// The probability that [`GuidingTree::sample`] chooses `light` at `ctx`
@@ -421,6 +435,9 @@ impl<H: LightHierarchy> GuidingTree<H> {
     /// The `f64` pmf before rounding to `f32`.
     #[inline]
     pub fn pmf_exact(&self, cut: &GuidingCut, ctx: &ShadingContext, light: LightId) -> f64 {
+        if !ctx.is_finite() {
+            return 0.0;
+        }
         Rule::new(self, cut, ctx).pmf(light)
     }
 

@@ -68,6 +68,9 @@ impl<S: LightSampler> WithEnvironment<S> {
 impl<S: LightSampler> LightSampler for WithEnvironment<S> {
     #[inline]
     fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+        if !ctx.is_finite() {
+            return None;
+        }
         let (pe, pl) = self.split();
         let mut d = Descent::new(u);
         match d.choose_with(pe, pl) {
@@ -94,6 +97,9 @@ impl<S: LightSampler> LightSampler for WithEnvironment<S> {
 
     #[inline]
     fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        if !ctx.is_finite() {
+            return 0.0;
+        }
         let (pe, pl) = self.split();
         let mut d = Descent::evaluate();
         match light {

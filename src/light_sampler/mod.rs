@@ -60,9 +60,14 @@ pub struct LightSample {
 /// Implementations take `&self` and are `Sync` when their data is, so a
 /// renderer shares one sampler between all its threads.
 pub trait LightSampler {
-    /// Chooses a light at `ctx` from one uniform number `u` in `[0, 1)`
-    /// (values outside are clamped). `None` when no light can be chosen:
-    /// no emitters, or every one has zero power.
+    /// Chooses a light at `ctx` from one uniform number `u` in `[0, 1)`.
+    /// `None` when no light can be chosen: no emitters, every one has zero
+    /// power, or `ctx`'s position is not finite
+    /// ([`ShadingContext::is_finite`]; every `pmf` is 0 there too).
+    ///
+    /// The same edges for every sampler of the crate
+    /// (`tests/edge_semantics.rs`): a `u` outside `[0, 1)` is clamped into
+    /// it and NaN counts as 0, so any sampler (QMC included) can drive it.
     fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample>;
 
     /// The probability that [`LightSampler::sample`] chooses `light` at

@@ -139,9 +139,9 @@ fn alias_table(weights: &[f64], total: f64) -> Vec<Bin> {
 
 impl LightSampler for PowerSampler {
     #[inline]
-    fn sample(&self, _ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
         let n = self.bins.len();
-        if n == 0 {
+        if n == 0 || !ctx.is_finite() {
             return None;
         }
         let x = Descent::new(u).u() * n as f64;
@@ -162,8 +162,9 @@ impl LightSampler for PowerSampler {
     }
 
     #[inline]
-    fn pmf(&self, _ctx: &ShadingContext, light: LightId) -> f32 {
+    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
         match light {
+            _ if !ctx.is_finite() => 0.0,
             LightId::Emitter(i) => self.bins.get(i as usize).map_or(0.0, |b| b.pmf),
             LightId::Environment => 0.0,
         }

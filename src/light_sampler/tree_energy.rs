@@ -36,12 +36,18 @@ impl<H: LightHierarchy> EnergyTreeSampler<H> {
 
 impl<H: LightHierarchy> LightSampler for EnergyTreeSampler<H> {
     #[inline]
-    fn sample(&self, _ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+        if !ctx.is_finite() {
+            return None;
+        }
         tree_walk::sample(&self.tree, u, energy_weights(&self.tree))
     }
 
     #[inline]
-    fn pmf(&self, _ctx: &ShadingContext, light: LightId) -> f32 {
+    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        if !ctx.is_finite() {
+            return 0.0;
+        }
         tree_walk::pmf(&self.tree, light, energy_weights(&self.tree))
     }
 

@@ -61,11 +61,17 @@ impl<H: LightHierarchy> ImportanceTreeSampler<H> {
 impl<H: LightHierarchy> LightSampler for ImportanceTreeSampler<H> {
     #[inline]
     fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+        if !ctx.is_finite() {
+            return None;
+        }
         tree_walk::sample(&self.tree, u, self.weights(ctx))
     }
 
     #[inline]
     fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        if !ctx.is_finite() {
+            return 0.0;
+        }
         tree_walk::pmf(&self.tree, light, self.weights(ctx))
     }
 

@@ -41,8 +41,8 @@ impl UniformSampler {
 
 impl LightSampler for UniformSampler {
     #[inline]
-    fn sample(&self, _ctx: &ShadingContext, u: f32) -> Option<LightSample> {
-        if self.is_empty() {
+    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+        if self.is_empty() || !ctx.is_finite() {
             return None;
         }
         let u = Descent::new(u).u();
@@ -55,7 +55,10 @@ impl LightSampler for UniformSampler {
     }
 
     #[inline]
-    fn pmf(&self, _ctx: &ShadingContext, light: LightId) -> f32 {
+    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        if !ctx.is_finite() {
+            return 0.0;
+        }
         match light {
             LightId::Emitter(i) if (i as u64) < self.count => self.pmf,
             _ => 0.0,

@@ -32,11 +32,12 @@ pub const MIN_UNIFORM_FRACTION: f32 = 1.0e-6;
 pub struct QuadtreeConfig {
     /// A quadrant whose share of the tree's total exceeds `rho` is split
     /// (becomes a node); a subtree whose share is at most `rho` is merged
-    /// into one leaf. Default `0.01` (PPG). Values below [`MIN_RHO`] (and
-    /// NaN) are raised to it.
+    /// into one leaf. Default `0.01` (PPG). In `[MIN_RHO, 1]`
+    /// ([`MIN_RHO`]).
     pub rho: f32,
     /// The deepest node level (the root is level 1, so leaves are at least
-    /// `2^-max_depth` wide). Default `20` (PPG). Clamped to `1..=MAX_DEPTH`.
+    /// `2^-max_depth` wide). Default `20` (PPG). In `1..=MAX_DEPTH`
+    /// ([`MAX_DEPTH`]).
     pub max_depth: u32,
 }
 
@@ -50,6 +51,25 @@ impl Default for QuadtreeConfig {
 }
 
 impl QuadtreeConfig {
+    /// Checks `rho` in `[MIN_RHO, 1]` and `max_depth` in `1..=MAX_DEPTH`.
+    /// A [`DirectionalTree`](super::DirectionalTree) refined with an
+    /// unchecked configuration uses the nearest valid values.
+    pub fn validate(&self) -> Result<(), crate::error::ConfigError> {
+        let rho = f64::from(self.rho);
+        crate::error::check(
+            "QuadtreeConfig::rho",
+            rho,
+            rho >= f64::from(MIN_RHO) && rho <= 1.0,
+            "in [1e-6, 1]",
+        )?;
+        crate::error::check(
+            "QuadtreeConfig::max_depth",
+            f64::from(self.max_depth),
+            (1..=MAX_DEPTH).contains(&self.max_depth),
+            "in 1..=24",
+        )
+    }
+
     /// `rho` as used: at least [`MIN_RHO`].
     pub(crate) fn effective_rho(&self) -> f64 {
         if self.rho >= MIN_RHO {

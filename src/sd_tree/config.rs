@@ -1,5 +1,6 @@
 //! SD-tree parameters.
 
+use crate::error::{self, ConfigError};
 use crate::math::Accumulation;
 use crate::quadtree::{DirectionalFilter, QuadtreeConfig};
 use crate::spatial::SpatialFilter;
@@ -13,9 +14,8 @@ pub struct SdTreeConfig {
     /// splats) exceeds `c * sqrt(2^k)`. Default 12000 (the paper). The
     /// "improved" setting 4000 splits at a third of the samples, giving a
     /// finer spatial subdivision for the same budget; PPG's released code
-    /// uses 4000 scaled by `sqrt(spp per pass / 4)`. NaN or negative values
-    /// act as 0 (split whenever anything was collected).
-    pub spatial_threshold: f32,
+    /// uses 4000 scaled by `sqrt(spp per pass / 4)`. Finite and positive.
+    pub spatial_threshold: f64,
     /// Directional refinement: `rho` and the depth limit of the quadtrees.
     pub quadtree: QuadtreeConfig,
     /// Spatial filter used by [`SdTree::splat`](super::SdTree::splat).
@@ -35,8 +35,8 @@ pub struct SdTreeConfig {
     pub max_bytes: Option<usize>,
     /// The BSDF sampling fraction `s` (probability of sampling the BSDF
     /// rather than the guiding distribution). Fixed when
-    /// `learn_bsdf_fraction` is false, the starting value otherwise. Clamped
-    /// to `[0, 1]`; NaN gives 0.5.
+    /// `learn_bsdf_fraction` is false, the starting value otherwise. In
+    /// `[0, 1]`.
     pub bsdf_fraction: f32,
     /// Learn `s` per cell (Müller 2019), see the
     /// [module docs](super#the-learned-bsdf-sampling-fraction).
@@ -78,12 +78,16 @@ impl SdTreeConfig {
     /// The split threshold after iteration `k`: `c * sqrt(2^k)` (computed in
     /// `f64`, saturating to infinity).
     pub fn split_threshold(&self, k: u32) -> f64 {
-        let c = if self.spatial_threshold >= 0.0 {
-            self.spatial_threshold as f64
-        } else {
-            0.0
-        };
-        crate::spatial::split_threshold(c, k)
+        crate::spatial::split_threshold(self.spatial_threshold.max(0.0), k)
+    }
+
+    /// Checks every field: `spatial_threshold` finite and positive, the
+    /// quadtrees' ([`QuadtreeConfig::validate`]), `bsdf_fraction` in
+    /// `[0, 1]`.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        error::positive("SdTreeConfig::spatial_threshold", self.spatial_threshold)?;
+        self.quadtree.validate()?;
+        error::unit("SdTreeConfig::bsdf_fraction", f64::from(self.bsdf_fraction))
     }
 
     /// `bsdf_fraction` as used: in `[0, 1]`, NaN as 0.5.

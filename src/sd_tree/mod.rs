@@ -101,7 +101,7 @@
 //! assert_eq!(pdf, tree.pdf(Vec3::ZERO, dir));
 //! assert!(tree.pdf(Vec3::ZERO, Vec3::Z) > 10.0 * tree.pdf(Vec3::ZERO, -Vec3::Z));
 //! assert_eq!(tree.dropped_splats().radiance, 1);
-//! # Ok::<(), guiding::spatial::SpatialError>(())
+//! # Ok::<(), guiding::Error>(())
 //! ```
 
 mod cell;
@@ -123,8 +123,9 @@ pub use fraction::{BETA1, BETA2, LEARNING_RATE, THETA_LIMIT};
 pub use memory::SdTreeMemory;
 pub(crate) use state::SdState;
 
+use crate::error::Error;
 use crate::math::Aabb;
-use crate::spatial::{BinaryTree, SpatialError};
+use crate::spatial::BinaryTree;
 
 /// Practical Path Guiding's SD-tree. See the [module docs](self).
 #[derive(Clone, Debug)]
@@ -135,8 +136,10 @@ pub struct SdTree {
 
 impl SdTree {
     /// One cell over the cube around `scene` (flat and point scenes are
-    /// padded), sampling uniformly. Errors for empty or non-finite bounds.
-    pub fn new(scene: Aabb, config: SdTreeConfig) -> Result<Self, SpatialError> {
+    /// padded), sampling uniformly. Errors for an invalid configuration
+    /// ([`SdTreeConfig::validate`]) and for empty or non-finite bounds.
+    pub fn new(scene: Aabb, config: SdTreeConfig) -> Result<Self, Error> {
+        config.validate()?;
         let state = SdState::new(config);
         Ok(Self {
             tree: BinaryTree::new(scene, state.new_cell())?,

@@ -1,0 +1,97 @@
+//! The same edge semantics for every light sampler: a random number outside
+//! `[0, 1)` is clamped into it and NaN counts as 0; a non-finite shading
+//! position chooses nothing (`sample` is `None`, every `pmf` is 0).
+
+mod common;
+
+use common::{Rand, scene, two_rooms, value};
+use glam::Vec3;
+use guiding::field::{FieldConfig, GuidingField};
+use guiding::glt::{CutConfig, Glt, GltConfig, GuidingTree};
+use guiding::light_tree::BuildHeuristic;
+use guiding::{
+    EnergyTreeSampler, ImportanceTreeSampler, LightId, LightSampler, LightTree, PowerSampler,
+    ShadingContext, UniformSampler, WithEnvironment,
+};
+
+/// The largest `f32` below one.
+const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// Checks the edge semantics of `s` (over `n` emitters) at finite points.
+fn check(name: &str, s: &dyn LightSampler, n: u32) {
+    let mut rng = Rand::new(4);
+    for _ in 0..50 {
+        let p = rng.point(9.0);
+        let ctx = ShadingContext::on_surface(p, rng.dir());
+        for (u, as_u) in [
+            (f32::NAN, 0.0),
+            (-1.0, 0.0),
+            (f32::NEG_INFINITY, 0.0),
+            (-0.0, 0.0),
+            (1.0, BELOW_ONE),
+            (7.5, BELOW_ONE),
+            (f32::INFINITY, BELOW_ONE),
+        ] {
+            assert_eq!(s.sample(&ctx, u), s.sample(&ctx, as_u), "{name}: u = {u}");
+        }
+        // Non-finite positions: nothing is chosen, nothing has probability.
+        for bad in [
+            Vec3::new(f32::NAN, 0.0, 0.0),
+            Vec3::new(0.0, f32::INFINITY, 0.0),
+            Vec3::splat(f32::NEG_INFINITY),
+        ] {
+            for ctx in [
+                ShadingContext::at(bad),
+                ShadingContext::on_surface(bad, Vec3::Y),
+            ] {
+                assert_eq!(s.sample(&ctx, 0.3), None, "{name}: {bad}");
+                for e in 0..n {
+                    assert_eq!(s.pmf(&ctx, LightId::Emitter(e)), 0.0, "{name}: {bad}");
+                }
+                assert_eq!(s.pmf(&ctx, LightId::Environment), 0.0, "{name}: {bad}");
+            }
+        }
+        // A non-finite normal counts as no normal.
+        let no_normal = ShadingContext::at(p);
+        let nan_normal = ShadingContext {
+            position: p,
+            normal: Some(Vec3::NAN),
+        };
+        let u = rng.f();
+        assert_eq!(s.sample(&nan_normal, u), s.sample(&no_normal, u), "{name}");
+    }
+}
+
+#[test]
+fn every_sampler_has_the_same_edges() {
+    let lights = two_rooms();
+    let n = lights.len() as u32;
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    check("uniform", &UniformSampler::new(lights.len()), n);
+    check("power", &PowerSampler::new(&lights), n);
+    check("energy tree", &EnergyTreeSampler::new(&tree), n);
+    check("importance tree", &ImportanceTreeSampler::new(&tree), n);
+    check(
+        "with environment",
+        &WithEnvironment::new(PowerSampler::new(&lights), 0.25),
+        n,
+    );
+    let mut glt = Glt::new(&tree, scene(), GltConfig::default()).unwrap();
+    let mut rng = Rand::new(1);
+    for _ in 0..3 {
+        for _ in 0..3000 {
+            let p = rng.point(9.5);
+            let s = glt.sample(&ShadingContext::at(p), rng.f()).unwrap();
+            if let LightId::Emitter(e) = s.light {
+                glt.splat(p, s.light, value(&lights, e, p) / s.pmf, &mut rng.0);
+            }
+        }
+        glt.refine();
+    }
+    check("glt", &glt, n);
+    let guide = GuidingTree::new(&tree, CutConfig::default()).unwrap();
+    let cut = guide.new_cut();
+    check("cut sampler", &guide.sampler(&cut), n);
+    let field = GuidingField::new(&tree, scene(), FieldConfig::default()).unwrap();
+    check("field", &field, n);
+}
