@@ -101,7 +101,7 @@ fn train<'a>(lights: &[Emitter], tree: &'a LightTree) -> Trained<'a> {
     .unwrap();
     let mut sd = SdTree::new(scene(), sd_config).unwrap();
     let glt_config = GltConfig {
-        spatial_threshold: sd_config.spatial_threshold as f64,
+        spatial_threshold: sd_config.spatial_threshold,
         ..GltConfig::default()
     };
     let mut glt = Glt::new(tree, scene(), glt_config).unwrap();
