@@ -1,36 +1,4 @@
-//! # guiding
-//!
-//! Learned light selection and directional guiding for path tracers: the
-//! Guiding Light Tree of Hamann, Jung and Dachsbacher (EGSR 2023) and the
-//! SD-tree of Practical Path Guiding (Müller et al. 2017) it plugs into.
-//!
-//! The renderer keeps its geometry, materials and ray casting; the crate
-//! never casts a ray. A renderer describes its lights through [`Emitters`],
-//! builds a [`LightTree`] once, and asks a [`LightSampler`] which light to
-//! connect to at each shading point.
-//!
-//! ```
-//! use guiding::{Emitter, LightTree, LightSampler, EnergyTreeSampler, ShadingContext, LightId};
-//! use guiding::light_tree::BuildHeuristic;
-//! use glam::Vec3;
-//!
-//! // Three point lights, one much brighter than the others.
-//! let lights = vec![
-//!     Emitter::point(Vec3::new(0.0, 2.0, 0.0), 100.0),
-//!     Emitter::point(Vec3::new(5.0, 2.0, 0.0), 1.0),
-//!     Emitter::point(Vec3::new(-5.0, 2.0, 0.0), 1.0),
-//! ];
-//! let tree = LightTree::build(&lights, BuildHeuristic::default())?;
-//! let sampler = EnergyTreeSampler::new(&tree);
-//!
-//! let ctx = ShadingContext::on_surface(Vec3::ZERO, Vec3::Y);
-//! let s = sampler.sample(&ctx, 0.5).expect("the scene has lights");
-//! // The returned probability is exactly what `pmf` says.
-//! assert_eq!(s.pmf, sampler.pmf(&ctx, s.light));
-//! // Selection follows power: the bright light gets 100/102.
-//! assert!((sampler.pmf(&ctx, LightId::Emitter(0)) - 100.0 / 102.0).abs() < 1e-6);
-//! # Ok::<(), guiding::light_tree::BuildError>(())
-//! ```
+#![doc = include_str!("../README.md")]
 //!
 //! ## Layers
 //!

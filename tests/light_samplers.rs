@@ -238,7 +238,13 @@ fn check_contract_with(
     // Nothing is chosen at a non-finite position (tests/edge_semantics.rs).
     let chooses = !s.is_empty() && ctx.is_finite();
     if !chooses {
-        prop_assert_eq!(sum, 0.0, "{} chooses nothing but its pmf sums to {}", name, sum);
+        prop_assert_eq!(
+            sum,
+            0.0,
+            "{} chooses nothing but its pmf sums to {}",
+            name,
+            sum
+        );
     } else {
         prop_assert!(
             (sum - 1.0).abs() < 1e-5,
