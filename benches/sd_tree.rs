@@ -54,7 +54,7 @@ fn trained(config: SdTreeConfig) -> SdTree {
 fn report(name: &str, t: &SdTree) {
     let m = t.memory();
     let max_qt_depth = t
-        .tree()
+        .spatial()
         .data_slice()
         .iter()
         .map(|c| c.directions().depth())
@@ -99,7 +99,7 @@ fn queries(c: &mut Criterion) {
     g.bench_function("locate", |b| {
         b.iter(|| {
             i = (i + 1) % QUERIES;
-            black_box(t.tree().locate(black_box(points[i])))
+            black_box(t.spatial().locate(black_box(points[i])))
         })
     });
     g.bench_function("sample", |b| {

@@ -49,6 +49,7 @@
 
 extern crate alloc;
 
+mod dropped;
 pub mod emitter;
 pub mod error;
 pub mod field;
@@ -69,6 +70,7 @@ pub use glam;
 /// its generator in this one's trait.
 pub use rand_core;
 
+pub use dropped::DroppedSplats;
 pub use emitter::{Emitter, Emitters, ShadingContext};
 pub use error::{ConfigError, Error};
 pub use light_sampler::{

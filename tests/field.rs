@@ -118,7 +118,7 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
             let p = rng.point(9.8);
             let ctx = ShadingContext::at(p);
             let v = field.vertex(p).unwrap();
-            let cut = &cuts[sd.tree().locate(p).unwrap().index()];
+            let cut = &cuts[sd.spatial().locate(p).unwrap().index()];
             // NEE: the vertex's cut and the reference cut agree.
             let u = rng.f();
             let s = v.sample(&ctx, u).unwrap();
@@ -155,9 +155,9 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
         for cut in &mut cuts {
             guide.refine(cut);
         }
-        let before = sd.tree().map_ref(|_| ());
+        let before = sd.spatial().map_ref(|_| ());
         assert_eq!(field.refine(), sd.refine());
-        let after = sd.tree();
+        let after = sd.spatial();
         cuts = after
             .cells()
             .map(|c| {
@@ -185,7 +185,7 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
     for _ in 0..200 {
         let p = rng.point(11.0);
         let ctx = ShadingContext::at(p);
-        let cut = &cuts[sd.tree().locate(p).unwrap().index()];
+        let cut = &cuts[sd.spatial().locate(p).unwrap().index()];
         let v = field.vertex(p).unwrap();
         for e in [0, 17, 39, 40, 79] {
             let l = LightId::Emitter(e);
@@ -603,9 +603,9 @@ fn bad_input_is_dropped_and_counted() {
         if q == p {
             assert_eq!(v.splat_light(l, x, &mut rng.0), SplatOutcome::Dropped);
         }
-        assert!(field.dropped_light_splats() >= 2 * (i as u64 + 1));
+        assert!(field.dropped_splats().light >= 2 * (i as u64 + 1));
     }
-    assert_eq!(field.dropped_light_splats(), 2 * 7 + 6);
+    assert_eq!(field.dropped_splats().light, 2 * 7 + 6);
     // Nothing was stored.
     let cell = field.spatial().data_slice()[0].clone();
     assert_eq!(cell.sd().building_weight(), 0.0);
@@ -617,7 +617,8 @@ fn bad_input_is_dropped_and_counted() {
         v.splat_light(LightId::Emitter(1), 0.0, &mut rng.0),
         SplatOutcome::Zero
     );
-    assert_eq!(field.dropped_splats().total(), 20);
+    // One report: 20 radiance and fraction records, 20 light splats.
+    assert_eq!(field.dropped_splats().total(), 20 + 20);
     // Queries at non-finite points.
     assert!(field.vertex(nan).is_none());
     let ctx = ShadingContext::at(nan);
@@ -630,7 +631,7 @@ fn bad_input_is_dropped_and_counted() {
     assert_eq!(field.cell_count(), 1);
     field.reset_dropped_splats();
     assert_eq!(field.dropped_splats().total(), 0);
-    assert_eq!(field.dropped_light_splats(), 0);
+    assert_eq!(field.dropped_splats().light, 0);
 }
 
 struct Input {

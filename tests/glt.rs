@@ -70,7 +70,7 @@ fn pmf_total<H: LightHierarchy + ?Sized>(
     ctx: &ShadingContext,
 ) -> f64 {
     let mut total = guide.pmf_exact(cut, ctx, LightId::Environment);
-    for e in 0..guide.tree().emitter_count() as u32 {
+    for e in 0..guide.light_tree().emitter_count() as u32 {
         let p = guide.pmf_exact(cut, ctx, LightId::Emitter(e));
         assert!(p.is_finite() && p >= 0.0, "pmf {p} for {e}");
         total += p;
@@ -80,7 +80,7 @@ fn pmf_total<H: LightHierarchy + ?Sized>(
 
 /// What the total pmf must be: 1 when anything can be sampled.
 fn expected_total<H: LightHierarchy + ?Sized>(guide: &GuidingTree<&H>) -> f64 {
-    let tree = guide.tree();
+    let tree = guide.light_tree();
     let emitters = tree.root().is_some_and(|r| tree.energy(r) > 0.0);
     let env = guide.config().environment.is_some();
     if emitters || env { 1.0 } else { 0.0 }

@@ -207,7 +207,7 @@ fn bad_splats_are_counted() {
     let mut lights = two_rooms();
     lights[5].power = 0.0;
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
-    let glt = Glt::new(&tree, scene(), GltConfig::default()).unwrap();
+    let mut glt = Glt::new(&tree, scene(), GltConfig::default()).unwrap();
     let mut rng = Rand::new(5);
     let p = Vec3::ONE;
     let bad = [
@@ -223,7 +223,7 @@ fn bad_splats_are_counted() {
     for (i, &(q, light, v)) in bad.iter().enumerate() {
         assert_eq!(glt.splat(q, light, v, &mut rng.0), SplatOutcome::Dropped);
         assert_eq!(glt.splat_at(q, light, v), SplatOutcome::Dropped);
-        assert_eq!(glt.dropped_splats(), 2 * (i as u64 + 1));
+        assert_eq!(glt.dropped_splats().light, 2 * (i as u64 + 1));
     }
     assert_eq!(
         glt.splat_at(p, LightId::Emitter(1), 0.0),
@@ -233,7 +233,10 @@ fn bad_splats_are_counted() {
         glt.splat_at(p, LightId::Emitter(1), 1.0),
         SplatOutcome::Recorded
     );
-    assert_eq!(glt.dropped_splats(), 16);
+    assert_eq!(glt.dropped_splats().light, 16);
+    assert_eq!(glt.dropped_splats().total(), 16);
+    glt.reset_dropped_splats();
+    assert_eq!(glt.dropped_splats().total(), 0);
     let (emitters, env) = glt.cut_at(p).unwrap().accumulated();
     assert_eq!((emitters, env), (1.0, 0.0));
     assert_eq!(glt.spatial().data_slice()[0].splats(), 2);

@@ -41,7 +41,7 @@ fn lobe_dir(rng: &mut Pcg32) -> Vec3 {
 /// uniformly (pdf 1 / 4 pi).
 fn train(tree: &SdTree, n: usize, seed: u64) {
     let mut rng = Pcg32::seed_from_u64(seed);
-    let b = tree.tree().root_bounds();
+    let b = tree.spatial().root_bounds();
     for _ in 0..n {
         let p = point_in(&mut rng, &b);
         let d = lobe_dir(&mut rng);
@@ -69,7 +69,7 @@ fn trained(c: f64) -> SdTree {
 fn pdf_integrates_to_one_in_every_cell() {
     let t = trained(300.0);
     assert!(t.cell_count() > 4, "{}", t.cell_count());
-    let tree = t.tree();
+    let tree = t.spatial();
     for cell in tree.cells() {
         let p = tree.cell_bounds(cell).center();
         let leaves = tree.data(cell).directions().sampling_leaves();
@@ -177,7 +177,7 @@ fn spatial_split_exactly_above_threshold_copies_and_halves() {
     splat_n(&t, p, 201);
     assert_eq!(t.refine().splits, 1);
     assert_eq!(t.cell_count(), 2);
-    let tree = t.tree();
+    let tree = t.spatial();
     let (a, b) = (
         tree.data_slice()[0].directions(),
         tree.data_slice()[1].directions(),
@@ -210,7 +210,7 @@ fn memory_report_and_budget() {
     assert_eq!(m.cells, t.cell_count());
     assert_eq!(m.spatial_nodes, 2 * m.cells - 1);
     let qn: usize = t
-        .tree()
+        .spatial()
         .data_slice()
         .iter()
         .map(|c| c.directions().node_count())
@@ -336,7 +336,7 @@ fn box_filters_spread_weight_by_overlap() {
     assert_eq!(t.cell_count(), 4);
     let mut rng = Pcg32::seed_from_u64(2);
     // Each cell gets the fraction of the cell-sized box around p it covers.
-    let tree = t.tree();
+    let tree = t.spatial();
     let b = tree.root_bounds();
     let p = Vec3::new(b.center().x, 0.3, 0.3);
     let cell = tree.cell_bounds(tree.locate(p).unwrap());
@@ -382,7 +382,7 @@ fn box_filters_spread_weight_by_overlap() {
         &mut rng
     ));
     let total: f64 = t
-        .tree()
+        .spatial()
         .data_slice()
         .iter()
         .map(|c| c.building_weight())
@@ -391,7 +391,7 @@ fn box_filters_spread_weight_by_overlap() {
 
     // Stochastic box: the same weights in expectation, one cell per splat.
     let before: Vec<f64> = t
-        .tree()
+        .spatial()
         .data_slice()
         .iter()
         .map(|c| c.building_weight())
@@ -409,7 +409,7 @@ fn box_filters_spread_weight_by_overlap() {
         ));
     }
     let gained: Vec<f64> = t
-        .tree()
+        .spatial()
         .data_slice()
         .iter()
         .zip(&before)
@@ -554,7 +554,7 @@ fn train_threaded(config: SdTreeConfig, data: &[Vec<Input>], threads: usize) -> 
 /// Everything learned, as bits.
 fn fingerprint(t: &SdTree) -> Vec<u64> {
     let mut out = vec![t.cell_count() as u64];
-    let tree = t.tree();
+    let tree = t.spatial();
     for c in tree.cells() {
         let b = tree.cell_bounds(c);
         out.extend(
@@ -617,7 +617,7 @@ fn threads_learn_exactly_what_one_thread_learns() {
         ..config
     };
     let weights = |t: &SdTree| {
-        t.tree()
+        t.spatial()
             .data_slice()
             .iter()
             .map(|c| c.building_weight())

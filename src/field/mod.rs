@@ -106,13 +106,14 @@ pub use config::FieldConfig;
 pub use memory::FieldMemory;
 pub use vertex::FieldVertex;
 
+use crate::dropped::{DropReason, DroppedSplats};
 use crate::emitter::ShadingContext;
 use crate::error::Error;
 use crate::glt::{GuidingTree, SplatOutcome};
 use crate::light_sampler::{LightId, LightSample, LightSampler};
 use crate::light_tree::LightHierarchy;
-use crate::math::{Aabb, Counter};
-use crate::sd_tree::{DroppedSplats, SdState};
+use crate::math::Aabb;
+use crate::sd_tree::SdState;
 use crate::spatial::{BinaryTree, CellId, RefineOutcome, SpatialFilter, SpatialTree};
 use glam::Vec3;
 
@@ -129,7 +130,6 @@ pub struct GuidingField<H: LightHierarchy> {
     sd: SdState,
     guide: GuidingTree<H>,
     light_filter: SpatialFilter,
-    light_dropped: Counter,
 }
 
 impl<H: LightHierarchy> GuidingField<H> {
@@ -152,7 +152,6 @@ impl<H: LightHierarchy> GuidingField<H> {
             sd,
             guide,
             light_filter: config.light_filter,
-            light_dropped: Counter::new(),
         })
     }
 
@@ -207,7 +206,7 @@ impl<H: LightHierarchy> GuidingField<H> {
 
     /// The light hierarchy.
     pub fn light_tree(&self) -> &H {
-        self.guide.tree()
+        self.guide.light_tree()
     }
 
     /// The guiding tree every cell's cut is used through.
@@ -230,24 +229,18 @@ impl<H: LightHierarchy> GuidingField<H> {
         self.cells.cell_count()
     }
 
-    /// Radiance splats and fraction records dropped for bad input so far,
-    /// per reason (as [`SdTree::dropped_splats`](crate::sd_tree::SdTree::dropped_splats)).
+    /// Splats and fraction records dropped for bad input so far, per
+    /// reason: radiance splats and fraction records as
+    /// [`SdTree::dropped_splats`](crate::sd_tree::SdTree::dropped_splats)
+    /// counts them, light splats in [`DroppedSplats::light`] (as
+    /// [`Glt::dropped_splats`](crate::glt::Glt::dropped_splats)).
     pub fn dropped_splats(&self) -> DroppedSplats {
         self.sd.dropped.snapshot()
-    }
-
-    /// Light splats dropped for bad input so far (as
-    /// [`Glt::dropped_splats`](crate::glt::Glt::dropped_splats)):
-    /// non-finite positions, negative or non-finite values, emitters out of
-    /// range or with zero power, the environment when none is configured.
-    pub fn dropped_light_splats(&self) -> u64 {
-        self.light_dropped.get()
     }
 
     /// Sets all dropped-input counters to zero.
     pub fn reset_dropped_splats(&mut self) {
         self.sd.dropped.reset();
-        self.light_dropped.reset();
     }
 
     /// Chooses a light at `ctx` from an `f64` number (53 bits), with the
@@ -277,7 +270,7 @@ impl<H: LightHierarchy> GuidingField<H> {
             .guide
             .splat_spread(&self.cells, (p, at), light, value, filter, |_| {});
         if outcome == SplatOutcome::Dropped {
-            self.light_dropped.bump();
+            self.sd.dropped.count(DropReason::Light);
         }
         outcome
     }

@@ -52,7 +52,7 @@ impl<H: LightHierarchy> GuidingField<H> {
     /// [`FieldConfig::light_filter`](super::FieldConfig::light_filter)
     /// spreads `p` over (by default the cell holding `p`; the stochastic
     /// box draws one `next_u64` of `rng`). Bad input is dropped and counted in
-    /// [`GuidingField::dropped_light_splats`]. Light splats add no spatial
+    /// [`GuidingField::dropped_splats`] (`light`). Light splats add no spatial
     /// weight.
     #[inline]
     pub fn splat_light<R: Rng + ?Sized>(

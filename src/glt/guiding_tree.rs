@@ -106,7 +106,7 @@ impl<H: LightHierarchy> GuidingTree<H> {
 
     /// The light hierarchy.
     #[inline]
-    pub fn tree(&self) -> &H {
+    pub fn light_tree(&self) -> &H {
         &self.tree
     }
 

@@ -17,7 +17,7 @@
 //! - `splat.rs`: recording direct-light estimates ([`GuidingTree::splat`]);
 //! - `refine.rs`: rebuilding the cut from its sums ([`GuidingTree::refine`]);
 //! - `config.rs`: [`CutConfig`], [`BelowCut`], [`SplitPrior`];
-//! - `field.rs`: [`Glt`], one cut per cell of its own spatial tree, a
+//! - `standalone.rs`: [`Glt`], one cut per cell of its own spatial tree, a
 //!   [`crate::LightSampler`].
 //!
 //! How it differs from the paper's code (see the crate's reference notes):
@@ -38,17 +38,17 @@
 mod config;
 mod cut;
 mod cut_node;
-mod field;
 mod guiding_tree;
 mod refine;
 mod sampling;
 mod splat;
+mod standalone;
 mod walk;
 
 pub use config::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
 pub use cut::{CutError, CutMemory, GuidingCut};
 pub use cut_node::{CutNode, Slot};
-pub use field::{Glt, GltCell, GltConfig, GltMemory};
 pub use guiding_tree::GuidingTree;
 pub use sampling::CutSampler;
 pub use splat::SplatOutcome;
+pub use standalone::{Glt, GltCell, GltConfig, GltMemory};

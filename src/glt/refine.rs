@@ -174,7 +174,7 @@ fn rebuild<H: LightHierarchy>(
     total: f64,
     anchor: Option<(&ImportanceTable, FastQuery)>,
 ) -> Vec<CutNode> {
-    let (tree, config, walk) = (guide.tree(), guide.config(), guide.walk());
+    let (tree, config, walk) = (guide.light_tree(), guide.config(), guide.walk());
     let (Some(root), Some(root_walk)) = (tree.root(), walk.root()) else {
         return Vec::new();
     };

@@ -168,7 +168,7 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
         let prior_importance = config.prior == Prior::Importance;
         Self {
             guide,
-            tree: guide.tree(),
+            tree: guide.light_tree(),
             nodes: &cut.nodes,
             below: config.below_cut,
             modulate,

@@ -71,7 +71,7 @@ impl<H: LightHierarchy> GuidingTree<H> {
             return SplatOutcome::Dropped;
         }
         let index = match light {
-            LightId::Emitter(e) => cut.slot_of(self.tree(), e),
+            LightId::Emitter(e) => cut.slot_of(self.light_tree(), e),
             LightId::Environment => self.config().environment.map(|_| cut.env_sum()),
         };
         let Some(index) = index else {

@@ -29,7 +29,7 @@ impl<H: LightHierarchy> EnergyTreeSampler<H> {
     }
 
     /// The hierarchy it descends.
-    pub fn tree(&self) -> &H {
+    pub fn light_tree(&self) -> &H {
         &self.tree
     }
 }

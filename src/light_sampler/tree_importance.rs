@@ -36,7 +36,7 @@ impl<H: LightHierarchy> ImportanceTreeSampler<H> {
     }
 
     /// The hierarchy it descends.
-    pub fn tree(&self) -> &H {
+    pub fn light_tree(&self) -> &H {
         &self.tree
     }
 

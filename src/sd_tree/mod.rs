@@ -106,7 +106,6 @@
 
 mod cell;
 mod config;
-mod dropped;
 mod fraction;
 mod memory;
 mod query;
@@ -118,11 +117,11 @@ mod validate;
 pub use crate::spatial::SpatialFilter;
 pub use cell::SdCell;
 pub use config::SdTreeConfig;
-pub use dropped::{DropReason, DroppedSplats};
 pub use fraction::{BETA1, BETA2, LEARNING_RATE, THETA_LIMIT};
 pub use memory::SdTreeMemory;
 pub(crate) use state::SdState;
 
+use crate::dropped::DroppedSplats;
 use crate::error::Error;
 use crate::math::Aabb;
 use crate::spatial::BinaryTree;
@@ -149,7 +148,7 @@ impl SdTree {
 
     /// The spatial tree and its cells.
     #[inline]
-    pub fn tree(&self) -> &BinaryTree<SdCell> {
+    pub fn spatial(&self) -> &BinaryTree<SdCell> {
         &self.tree
     }
 

@@ -1,9 +1,9 @@
 //! Recording radiance and fraction samples, with the spatial filters.
 
-use super::dropped::DropReason;
 use super::state::SdState;
 use super::validate::splat_value;
 use super::{SdCell, SdTree, SpatialFilter};
+use crate::dropped::DropReason;
 use crate::math::Aabb;
 use crate::math::unit_direction;
 use crate::quadtree::DirectionalFilter;

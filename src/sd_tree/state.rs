@@ -5,7 +5,7 @@
 
 use super::SdCell;
 use super::config::SdTreeConfig;
-use super::dropped::DropCounters;
+use crate::dropped::DropCounters;
 
 /// The SD-tree's configuration, iteration count and dropped-input counters.
 #[derive(Clone, Debug)]

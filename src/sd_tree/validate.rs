@@ -1,6 +1,6 @@
 //! Checking the inputs of queries and splats.
 
-use super::dropped::DropReason;
+use crate::dropped::DropReason;
 
 /// The value a splat records, `radiance / pdf`, or why it is dropped.
 #[inline]

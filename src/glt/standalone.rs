@@ -7,13 +7,16 @@ use super::cut::{CutMemory, GuidingCut};
 use super::cut_node::CutNode;
 use super::guiding_tree::GuidingTree;
 use super::splat::SplatOutcome;
+use crate::dropped::{DropCounters, DropReason, DroppedSplats};
 use crate::emitter::ShadingContext;
 use crate::error::{ConfigError, Error};
 use crate::light_sampler::{LightId, LightSample, LightSampler};
 use crate::light_tree::LightHierarchy;
 use crate::math::pmf_to_f32;
 use crate::math::{Aabb, Counter};
-use crate::spatial::{BinaryTree, CellId, SpatialFilter, SpatialTree, jitter_u64, split_threshold};
+use crate::spatial::{
+    BinaryTree, CellId, RefineOutcome, SpatialFilter, SpatialTree, jitter_u64, split_threshold,
+};
 use glam::Vec3;
 use rand_core::Rng;
 
@@ -142,7 +145,7 @@ pub struct Glt<H: LightHierarchy> {
     config: GltConfig,
     spatial: BinaryTree<GltCell>,
     iteration: u32,
-    dropped: Counter,
+    dropped: DropCounters,
 }
 
 impl<H: LightHierarchy> Glt<H> {
@@ -164,13 +167,13 @@ impl<H: LightHierarchy> Glt<H> {
             config,
             spatial: BinaryTree::new(scene, cell)?,
             iteration: 0,
-            dropped: Counter::new(),
+            dropped: DropCounters::default(),
         })
     }
 
     /// The light hierarchy.
-    pub fn tree(&self) -> &H {
-        self.guide.tree()
+    pub fn light_tree(&self) -> &H {
+        self.guide.light_tree()
     }
 
     /// The guiding tree every cell's cut is used through.
@@ -200,11 +203,16 @@ impl<H: LightHierarchy> Glt<H> {
         Some(&self.spatial.data(cell).cut)
     }
 
-    /// Splats dropped as bad input since creation: non-finite or negative
-    /// values or positions, emitters out of range or with zero power, the
-    /// environment when none is configured.
-    pub fn dropped_splats(&self) -> u64 {
-        self.dropped.get()
+    /// Splats dropped as bad input so far, all in [`DroppedSplats::light`]:
+    /// non-finite or negative values or positions, emitters out of range or
+    /// with zero power, the environment when none is configured.
+    pub fn dropped_splats(&self) -> DroppedSplats {
+        self.dropped.snapshot()
+    }
+
+    /// Sets the dropped-input counters to zero.
+    pub fn reset_dropped_splats(&mut self) {
+        self.dropped.reset();
     }
 
     /// Chooses a light at `ctx` from an `f64` number (53 bits), with the
@@ -273,18 +281,20 @@ impl<H: LightHierarchy> Glt<H> {
 
     #[inline]
     fn reject(&self) {
-        self.dropped.bump();
+        self.dropped.count(DropReason::Light);
     }
 
     /// Ends an iteration: splits cells that received more than
     /// `c * sqrt(2^k)` splats (both halves get a copy of the cut and its
     /// sums), refines every cut from its sums (a cell that collected nothing
-    /// keeps its cut) and zeroes the sums and counts.
-    pub fn refine(&mut self) {
+    /// keeps its cut) and zeroes the sums and counts. Returns what the
+    /// spatial refinement did, as [`SdTree::refine`](crate::sd_tree::SdTree::refine)
+    /// and [`GuidingField::refine`](crate::field::GuidingField::refine) do.
+    pub fn refine(&mut self) -> RefineOutcome {
         for cell in self.spatial.data_slice_mut() {
             cell.split_count = cell.splats.get();
         }
-        self.spatial.split_by_weight(
+        let outcome = self.spatial.split_by_weight(
             split_threshold(self.config.spatial_threshold, self.iteration),
             |cell| cell.split_count as f64,
             |cell| cell.split_count /= 2,
@@ -297,6 +307,7 @@ impl<H: LightHierarchy> Glt<H> {
             cell.split_count = 0;
         }
         self.iteration = self.iteration.saturating_add(1);
+        outcome
     }
 
     /// Bytes used, by part.

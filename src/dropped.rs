@@ -1,4 +1,5 @@
-//! Counting the bad input that splats and fraction records drop.
+//! Counting the bad input that splats and fraction records drop: one
+//! [`DroppedSplats`] report for the SD-tree, the GLT and the field.
 
 #[cfg(not(target_has_atomic = "64"))]
 use core::sync::atomic::AtomicU32 as AtomicCount;
@@ -8,7 +9,7 @@ use core::sync::atomic::Ordering::Relaxed;
 
 /// Why a splat or fraction record was dropped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum DropReason {
+pub(crate) enum DropReason {
     /// The position has a NaN or infinite coordinate.
     Position,
     /// The direction is NaN, infinite or of zero length.
@@ -21,9 +22,13 @@ pub enum DropReason {
     Pdf,
     /// `radiance / pdf` overflowed `f32`.
     Overflow,
+    /// A light splat: a non-finite position, a negative or non-finite
+    /// value, an emitter out of range or without power, or the environment
+    /// where none is configured.
+    Light,
 }
 
-const REASONS: usize = 5;
+const REASONS: usize = 6;
 
 /// Snapshot of how many splats and fraction records were dropped, per
 /// reason. Dropped input is never stored.
@@ -39,12 +44,17 @@ pub struct DroppedSplats {
     pub pdf: u64,
     /// `radiance / pdf` not representable in `f32`.
     pub overflow: u64,
+    /// Light splats (of the GLT or the field's cuts), every reason
+    /// together: a non-finite position, a negative or non-finite value, an
+    /// emitter out of range or without power, or the environment where none
+    /// is configured.
+    pub light: u64,
 }
 
 impl DroppedSplats {
     /// All dropped inputs.
     pub fn total(&self) -> u64 {
-        self.position + self.direction + self.radiance + self.pdf + self.overflow
+        self.position + self.direction + self.radiance + self.pdf + self.overflow + self.light
     }
 }
 
@@ -71,6 +81,7 @@ impl DropCounters {
             radiance: get(DropReason::Radiance),
             pdf: get(DropReason::Pdf),
             overflow: get(DropReason::Overflow),
+            light: get(DropReason::Light),
         }
     }
 
