@@ -75,8 +75,11 @@ impl Emitter {
         }
     }
 
-    /// A one-sided Lambertian planar emitter (quad, triangle, disk) with the
-    /// given bounds, normal and area.
+    /// A one-sided Lambertian planar emitter with the given bounds, normal
+    /// and area; prefer [`Emitter::triangle`], [`Emitter::quad`] or
+    /// [`Emitter::disk`], which compute them. A zero or non-finite `normal`
+    /// gives an omnidirectional emitter (a conservative bound: it is never
+    /// discounted by orientation).
     pub fn area(bounds: Aabb, normal: Vec3, area: f32, power: f32) -> Self {
         Self {
             bounds,
@@ -85,6 +88,102 @@ impl Emitter {
             cone: Some(LightCone::lambertian(normal)),
             two_sided: false,
             delta: false,
+        }
+    }
+
+    /// A Lambertian triangle emitting on the side of
+    /// `(p1 - p0) x (p2 - p0)` (both sides when `two_sided`). A degenerate
+    /// triangle (zero area) is omnidirectional with area 0.
+    pub fn triangle(p: [Vec3; 3], power: f32, two_sided: bool) -> Self {
+        let n = (p[1] - p[0]).cross(p[2] - p[0]);
+        let bounds = Aabb::new(p[0], p[1]).union(&Aabb::from_point(p[2]));
+        Self {
+            two_sided,
+            ..Self::area(bounds, n, 0.5 * n.length(), power)
+        }
+    }
+
+    /// A Lambertian parallelogram `corner + s edge_u + t edge_v`
+    /// (`s, t` in `[0, 1]`), emitting on the side of `edge_u x edge_v`
+    /// (both sides when `two_sided`).
+    pub fn quad(corner: Vec3, edge_u: Vec3, edge_v: Vec3, power: f32, two_sided: bool) -> Self {
+        let n = edge_u.cross(edge_v);
+        let bounds = Aabb::new(corner, corner + edge_u + edge_v)
+            .union(&Aabb::new(corner + edge_u, corner + edge_v));
+        Self {
+            two_sided,
+            ..Self::area(bounds, n, n.length(), power)
+        }
+    }
+
+    /// A Lambertian disk of `radius` around `center`, emitting on the side
+    /// of `normal` (both sides when `two_sided`). Its box is the disk's own
+    /// (`radius * sqrt(1 - n_i^2)` along axis `i`), not the sphere's.
+    pub fn disk(center: Vec3, normal: Vec3, radius: f32, power: f32, two_sided: bool) -> Self {
+        let n = normal.try_normalize().unwrap_or(Vec3::ZERO);
+        let half = if n == Vec3::ZERO {
+            Vec3::splat(radius)
+        } else {
+            (Vec3::ONE - n * n)
+                .max(Vec3::ZERO)
+                .map(crate::math::scalar::sqrt)
+                * radius
+        };
+        Self {
+            two_sided,
+            ..Self::area(
+                Aabb::new(center - half, center + half),
+                n,
+                core::f32::consts::PI * radius * radius,
+                power,
+            )
+        }
+    }
+
+    /// A spot light at `position` shining along `direction`, at full
+    /// intensity within the angle whose cosine is `cos_falloff_start` and
+    /// dark beyond `cos_falloff_end` (pbrt's spot light). Its cone is
+    /// pbrt-v4's: the normal cone spans the full-intensity angle and the
+    /// emission falloff the rest.
+    pub fn spot(
+        position: Vec3,
+        direction: Vec3,
+        cos_falloff_start: f32,
+        cos_falloff_end: f32,
+        power: f32,
+    ) -> Self {
+        let start = crate::math::scalar::acos(cos_falloff_start.clamp(-1.0, 1.0));
+        let end = crate::math::scalar::acos(cos_falloff_end.clamp(-1.0, 1.0)).max(start);
+        Self {
+            cone: Some(LightCone::new(direction, start, end - start)),
+            ..Self::point(position, power)
+        }
+    }
+
+    /// pbrt-v4's `LightBounds` one-to-one: `bounds`, the normal-cone axis
+    /// `w`, the power `phi`, `cos_theta_o`, `cos_theta_e` and `two_sided`.
+    /// `area` and `delta` are what the renderer's light is (they only
+    /// matter to the renderer's own bookkeeping and to
+    /// [`Emitters::is_delta`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn from_light_bounds(
+        bounds: Aabb,
+        w: Vec3,
+        phi: f32,
+        cos_theta_o: f32,
+        cos_theta_e: f32,
+        two_sided: bool,
+        area: f32,
+        delta: bool,
+    ) -> Self {
+        let angle = |c: f32| crate::math::scalar::acos(c.clamp(-1.0, 1.0));
+        Self {
+            bounds,
+            power: phi,
+            area,
+            cone: Some(LightCone::new(w, angle(cos_theta_o), angle(cos_theta_e))),
+            two_sided,
+            delta,
         }
     }
 
