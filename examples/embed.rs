@@ -19,6 +19,7 @@ use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::UniformSampler;
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Aabb;
+use guiding::mis::power_heuristic;
 use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
 use rand_pcg::Pcg32;
 use rand_pcg::rand_core::{Rng, SeedableRng};
@@ -72,11 +73,6 @@ fn hit_light(lights: &[Sphere], p: Vec3, dir: Vec3) -> Option<usize> {
     best.1
 }
 
-/// Power heuristic.
-fn mis(a: f32, b: f32) -> f32 {
-    a * a / (a * a + b * b)
-}
-
 /// One irradiance estimate at `p` (normal +y): one NEE sample and one
 /// cosine-sampled direction, MIS-combined. With `train`, both are splatted
 /// into the GLT.
@@ -100,7 +96,7 @@ fn estimate(
         let cos = n.dot(dir);
         if cos > 0.0 && visible(p, light.center) {
             let p_light = s.pmf * pdf_dir;
-            let w = mis(p_light, cos / PI);
+            let w = power_heuristic(p_light, cos / PI);
             e += light.radiance * cos * w / p_light;
             if let Some(glt) = glt {
                 // Splat: Le * T * w_mis / (pdf_solid_angle * pmf).
@@ -119,7 +115,7 @@ fn estimate(
         if visible(p, light.center) {
             let (_, pdf_dir) = sample_sphere(light, p, [0.0, 0.0]);
             let id = LightId::Emitter(i as u32);
-            let w = mis(pdf_bsdf, sampler.pmf(&ctx, id) * pdf_dir);
+            let w = power_heuristic(pdf_bsdf, sampler.pmf(&ctx, id) * pdf_dir);
             e += light.radiance * dir.y * w / pdf_bsdf;
             if let Some(glt) = glt {
                 // Splat: Le * w_mis / pdf_direction.

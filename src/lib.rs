@@ -57,6 +57,8 @@ pub mod glt;
 pub mod light_sampler;
 pub mod light_tree;
 pub mod math;
+pub mod mis;
+pub mod path_recorder;
 pub mod quadtree;
 pub mod schedule;
 pub mod sd_tree;
@@ -78,3 +80,4 @@ pub use light_sampler::{
     UniformSampler, WithEnvironment,
 };
 pub use light_tree::{LightHierarchy, LightTree};
+pub use path_recorder::PathRecorder;

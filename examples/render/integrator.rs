@@ -13,8 +13,11 @@ use crate::scene::Scene;
 use glam::Vec3;
 use guiding::field::{FieldVertex, GuidingField};
 use guiding::glt::Glt;
+use guiding::mis::power_heuristic;
+use guiding::path_recorder::{RadianceRecords, Segment};
+use guiding::rand_core::Rng;
 use guiding::sd_tree::{SdCell, SdTree};
-use guiding::{LightId, LightSampler, LightTree, ShadingContext};
+use guiding::{LightId, LightSampler, LightTree, PathRecorder, ShadingContext};
 
 /// What a path consults and trains.
 #[derive(Clone, Copy)]
@@ -40,18 +43,26 @@ pub struct Guides<'a> {
 /// the vertex's queries and every record made there later.
 type Located<'a> = FieldVertex<'a, &'a LightTree>;
 
-/// One guided path vertex awaiting its SD-tree splat.
-#[derive(Clone, Copy, Debug)]
-pub struct Record<'a> {
-    at: Option<Located<'a>>,
-    pos: Vec3,
-    dir: Vec3,
-    pdf: f32,
-    bsdf_pdf: f32,
-    guide_pdf: f32,
-    weight: Vec3,
-    beta_after: Vec3,
-    radiance: Vec3,
+/// The recorder of a path's segments, each with the field vertex it was
+/// located in (`None` for `ppg`'s SD-tree, which locates again).
+pub type Recorder<'a> = PathRecorder<Option<Located<'a>>>;
+
+/// Where the recorder's segments go: the SD-tree, or the field through the
+/// vertex each segment kept.
+impl<'a> RadianceRecords<Option<Located<'a>>> for Guides<'a> {
+    fn record<R: Rng + ?Sized>(
+        &self,
+        seg: &Segment<Option<Located<'a>>>,
+        radiance: f32,
+        contribution: f32,
+        rng: &mut R,
+    ) {
+        if let Some(t) = self.sd_tree {
+            t.record(&seg.with_cell(()), radiance, contribution, rng);
+        } else if let (Some(field), Some(v)) = (self.field, seg.cell) {
+            field.record(&seg.with_cell(v), radiance, contribution, rng);
+        }
+    }
 }
 
 /// The last scattering vertex, for MIS at the next emitter hit.
@@ -126,55 +137,23 @@ fn splat_value(guides: &Guides, f_cos: Vec3, le: Vec3) -> f32 {
     }
 }
 
-/// Power heuristic weight of technique `a` against `b`.
-#[inline]
-fn mis(a: f32, b: f32) -> f32 {
-    if a.is_infinite() {
-        return 1.0;
-    }
-    let (a2, b2) = (a * a, b * b);
-    if a2 + b2 > 0.0 { a2 / (a2 + b2) } else { 0.0 }
-}
-
-/// Componentwise `c / d`, 0 where `d` is 0.
-#[inline]
-fn safe_div(c: Vec3, d: Vec3) -> Vec3 {
-    Vec3::new(
-        if d.x > 0.0 { c.x / d.x } else { 0.0 },
-        if d.y > 0.0 { c.y / d.y } else { 0.0 },
-        if d.z > 0.0 { c.z / d.z } else { 0.0 },
-    )
-}
-
-/// Adds a contribution to the pixel and to the incident radiance of every
-/// recorded vertex before it.
-#[inline]
-fn contribute(l: &mut Vec3, records: &mut [Record<'_>], c: Vec3) {
-    *l += c;
-    for r in records.iter_mut() {
-        r.radiance += safe_div(c, r.beta_after);
-    }
-}
-
 /// The radiance arriving at the camera along `origin + t dir`.
-/// `records` is scratch space reused between paths.
+/// `recorder` is reused between paths (it keeps its storage).
 pub fn radiance<'a>(
     scene: &Scene,
     guides: &Guides<'a>,
     mut origin: Vec3,
     mut dir: Vec3,
     s: &mut Sampler,
-    records: &mut Vec<Record<'a>>,
+    recorder: &mut Recorder<'a>,
 ) -> Vec3 {
     let max_depth = scene.effects.max_depth;
     let train_light = guides.train && (guides.glt.is_some() || guides.field.is_some());
     let train_sd = guides.train && (guides.sd_tree.is_some() || guides.field.is_some());
-    let mut l = Vec3::ZERO;
-    let mut beta = Vec3::ONE;
     let mut prev: Option<Vertex> = None;
     // True while every vertex so far was a delta (specular) one.
     let mut specular_chain = true;
-    records.clear();
+    recorder.clear();
     for depth in 0..max_depth {
         let Some(hit) = scene.intersect(origin, dir) else {
             if let Some(env) = &scene.environment {
@@ -183,11 +162,11 @@ pub fn radiance<'a>(
                         let ctx = ShadingContext::on_surface(v.pos, v.normal);
                         let p_light =
                             guides.lights.pmf(&ctx, LightId::Environment) * env.pdf(v.normal, dir);
-                        (mis(v.pdf_dir, p_light), v.pdf_dir)
+                        (power_heuristic(v.pdf_dir, p_light), v.pdf_dir)
                     }
                     _ => (1.0, 0.0),
                 };
-                contribute(&mut l, records, beta * env.radiance * w);
+                recorder.add_radiance(env.radiance * w);
                 if let (true, Some(v)) = (train_light, prev)
                     && !v.delta
                     && pdf_dir > 0.0
@@ -215,11 +194,11 @@ pub fn radiance<'a>(
                         let ctx = ShadingContext::on_surface(v.pos, v.normal);
                         let dist = (p - v.pos).length();
                         let p_light = guides.lights.pmf(&ctx, id) * light.pdf(v.pos, dir, dist, ng);
-                        (mis(v.pdf_dir, p_light), v.pdf_dir)
+                        (power_heuristic(v.pdf_dir, p_light), v.pdf_dir)
                     }
                     _ => (1.0, 0.0),
                 };
-                contribute(&mut l, records, beta * le * w);
+                recorder.add_radiance(le * w);
                 if let (true, Some(v)) = (train_light, prev)
                     && !v.delta
                     && pdf_dir > 0.0
@@ -240,7 +219,7 @@ pub fn radiance<'a>(
             let Some(bs) = mat.sample(ng, wo, s.next2(), s.next()) else {
                 break;
             };
-            beta *= bs.weight;
+            recorder.scatter_unrecorded(bs.weight);
             prev = Some(Vertex {
                 at: None,
                 pos: p,
@@ -296,16 +275,16 @@ pub fn radiance<'a>(
                 if f.max_element() > 0.0 && lp.pdf > 0.0 && lp.radiance.max_element() > 0.0 {
                     let p_light = ls.pmf * lp.pdf;
                     let (p_dir, _) = dir_pdf(lp.wi, bsdf_pdf);
-                    let w = mis(p_light, p_dir);
+                    let w = power_heuristic(p_light, p_dir);
                     let o = offset_origin(p, n, lp.wi);
                     let target = match ls.light {
                         LightId::Emitter(e) => e,
                         LightId::Environment => NO_EMITTER,
                     };
                     if !scene.occluded(o, lp.wi, lp.dist, target) {
-                        let c = beta * f * lp.radiance * (w / p_light);
+                        let c = f * lp.radiance * (w / p_light);
                         if c.is_finite() {
-                            contribute(&mut l, records, c);
+                            recorder.add_radiance(c);
                             if train_light {
                                 let value = splat_value(guides, f, lp.radiance) * w / p_light;
                                 splat_light(guides, &here, ls.light, value, s);
@@ -336,19 +315,10 @@ pub fn radiance<'a>(
             break;
         }
         let weight = f_cos / pdf;
-        beta *= weight;
         if train_sd {
-            records.push(Record {
-                at: field_vertex,
-                pos: p,
-                dir: wi,
-                pdf,
-                bsdf_pdf,
-                guide_pdf,
-                weight,
-                beta_after: beta,
-                radiance: Vec3::ZERO,
-            });
+            recorder.push_segment(field_vertex, p, wi, pdf, bsdf_pdf, guide_pdf, weight);
+        } else {
+            recorder.scatter_unrecorded(weight);
         }
         prev = Some(Vertex {
             pdf_dir: pdf,
@@ -359,18 +329,8 @@ pub fn radiance<'a>(
         dir = wi;
     }
     if train_sd {
-        for r in records.iter().filter(|r| r.radiance.is_finite()) {
-            let radiance = luminance(r.radiance);
-            let contribution = luminance(r.weight * r.radiance);
-            if let Some(t) = guides.sd_tree {
-                t.splat(r.pos, r.dir, radiance, r.pdf, s.rng());
-                t.record_fraction(r.pos, r.bsdf_pdf, r.guide_pdf, contribution);
-            } else if let Some(v) = &r.at {
-                // The field: no second lookup, the vertex kept its cell.
-                v.splat_radiance(r.dir, radiance, r.pdf, s.rng());
-                v.record_fraction(r.bsdf_pdf, r.guide_pdf, contribution);
-            }
-        }
+        recorder.finish(guides, s.rng());
     }
+    let l = recorder.estimate();
     if l.is_finite() { l } else { Vec3::ZERO }
 }

@@ -3,7 +3,7 @@
 //! schedule (2^k passes, the last taking the rest) and combine their last
 //! iterations by inverse variance, as PPG does.
 
-use crate::integrator::{Guides, radiance};
+use crate::integrator::{Guides, Recorder, radiance};
 use crate::lights::luminance;
 use crate::methods::{GuideParams, Method, fixed_sampler, new_field, new_glt, new_sd_tree};
 use crate::rng::Sampler;
@@ -90,7 +90,7 @@ fn render_pass(scene: &Scene, guides: &Guides, settings: &Settings, pass: u64, o
         .enumerate()
         .map(|(i, &(x0, y0))| {
             let mut s = Sampler::new(settings.seed, pass, i as u64);
-            let mut records = Vec::new();
+            let mut recorder = Recorder::new();
             let mut px = Vec::with_capacity((TILE * TILE) as usize);
             for y in y0..(y0 + TILE).min(h) {
                 for x in x0..(x0 + TILE).min(w) {
@@ -102,7 +102,7 @@ fn render_pass(scene: &Scene, guides: &Guides, settings: &Settings, pass: u64, o
                         scene.camera.eye,
                         dir,
                         &mut s,
-                        &mut records,
+                        &mut recorder,
                     ));
                 }
             }

@@ -1,0 +1,273 @@
+//! [`PathRecorder`]: the bookkeeping every guided integrator repeats, in
+//! one place. The renderer reports what happened along a path (the
+//! scattering at each vertex, and every MIS-weighted radiance the path
+//! found); the recorder keeps the pixel estimate and, at the end of the
+//! path, the radiance that arrived at each vertex along the direction the
+//! path left it in, which is what the SD-tree (PPG) learns from.
+//!
+//! ```text
+//! recorder.clear();
+//! loop {
+//!     hit emitter   -> recorder.add_radiance(Le * w_bsdf)          // MIS-weighted
+//!     NEE at vertex -> recorder.add_radiance(f cos Le * w_light / p)
+//!     scatter       -> recorder.push_segment(cell, x, wi, pdf, bsdf_pdf, guide_pdf, f cos / pdf)
+//!     specular      -> recorder.scatter_unrecorded(f cos / pdf)
+//! }
+//! recorder.finish(&guide, &mut rng);   // the SD-tree's (or the field's) records
+//! let pixel = recorder.estimate();
+//! ```
+//!
+//! The radiance arriving at vertex `i` is computed at the end by one
+//! backward pass, `L_i = e_i + s_i w_(i+1) L_(i+1)` (`e_i` the radiance the
+//! path found at the end of segment `i`, `w_(i+1)` the throughput factor
+//! of the next recorded segment, `s_i` that of the specular scatterings
+//! between them), without dividing by the path throughput: a colour channel
+//! that the throughput zeroes loses nothing of the others.
+//!
+//! Light splats (the GLT's records) do not wait for the end of the path:
+//! the renderer makes them where it finds direct light, with
+//! [`crate::glt::Glt::splat`] or a field vertex.
+
+use crate::field::{FieldVertex, GuidingField};
+use crate::light_tree::LightHierarchy;
+use crate::sd_tree::SdTree;
+use alloc::vec::Vec;
+use glam::Vec3;
+use rand_core::Rng;
+
+/// The luminance of linear Rec. 709 RGB, the scalar the recorder delivers
+/// radiance as (`0.2126 r + 0.7152 g + 0.0722 b`).
+#[inline]
+pub fn luminance(c: Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+/// One scattering of a path: where it left from, in which direction, with
+/// which pdfs and throughput factor, and (after [`PathRecorder::finish`])
+/// the radiance that arrived back along it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Segment<C> {
+    /// What the renderer located at this vertex (a field vertex, or `()`
+    /// for an SD-tree, which locates the cell again when recording).
+    pub cell: C,
+    /// The vertex the path left from.
+    pub position: Vec3,
+    /// The direction it left in (unit).
+    pub direction: Vec3,
+    /// The solid-angle pdf the direction was sampled with (the mixture of
+    /// BSDF and guide sampling).
+    pub pdf: f32,
+    /// The BSDF's pdf of the direction.
+    pub bsdf_pdf: f32,
+    /// The guide's pdf of the direction (0 without a guide).
+    pub guide_pdf: f32,
+    /// The throughput factor `f cos / pdf` of the segment.
+    pub weight: Vec3,
+    /// MIS-weighted radiance found at the end of this segment (the
+    /// emitter it hit, and what next-event estimation found there).
+    pub found: Vec3,
+    /// The radiance that arrived at `position` along `direction`, filled
+    /// by [`PathRecorder::finish`].
+    pub incident: Vec3,
+    /// The throughput of the unrecorded (specular) scatterings after this
+    /// segment so far, applied to what is found after them.
+    factor: Vec3,
+}
+
+impl<C> Segment<C> {
+    /// The same segment with another `cell` (to route it to a structure
+    /// that located it differently).
+    pub fn with_cell<D>(&self, cell: D) -> Segment<D> {
+        Segment {
+            cell,
+            position: self.position,
+            direction: self.direction,
+            pdf: self.pdf,
+            bsdf_pdf: self.bsdf_pdf,
+            guide_pdf: self.guide_pdf,
+            weight: self.weight,
+            found: self.found,
+            incident: self.incident,
+            factor: self.factor,
+        }
+    }
+}
+
+/// Where a recorder's segments go at the end of a path: the SD-tree's
+/// radiance splat and BSDF-fraction record, or the field's through the
+/// vertex the renderer located. Implement it for a renderer's own
+/// structure to route records elsewhere.
+pub trait RadianceRecords<C> {
+    /// Records one finished segment. `radiance` is
+    /// `luminance(segment.incident)`, `contribution` is
+    /// `luminance(segment.weight * segment.incident)` (what the learned
+    /// BSDF fraction optimises).
+    fn record<R: Rng + ?Sized>(
+        &self,
+        segment: &Segment<C>,
+        radiance: f32,
+        contribution: f32,
+        rng: &mut R,
+    );
+}
+
+impl RadianceRecords<()> for SdTree {
+    #[inline]
+    fn record<R: Rng + ?Sized>(
+        &self,
+        s: &Segment<()>,
+        radiance: f32,
+        contribution: f32,
+        rng: &mut R,
+    ) {
+        self.splat(s.position, s.direction, radiance, s.pdf, rng);
+        self.record_fraction(s.position, s.bsdf_pdf, s.guide_pdf, contribution);
+    }
+}
+
+impl<'f, H: LightHierarchy> RadianceRecords<FieldVertex<'f, H>> for GuidingField<H> {
+    #[inline]
+    fn record<R: Rng + ?Sized>(
+        &self,
+        s: &Segment<FieldVertex<'f, H>>,
+        radiance: f32,
+        contribution: f32,
+        rng: &mut R,
+    ) {
+        s.cell.splat_radiance(s.direction, radiance, s.pdf, rng);
+        s.cell
+            .record_fraction(s.bsdf_pdf, s.guide_pdf, contribution);
+    }
+}
+
+/// The bookkeeping of one path at a time (reuse it between paths: its
+/// storage is kept). See the [module docs](self).
+#[derive(Clone, Debug)]
+pub struct PathRecorder<C = ()> {
+    segments: Vec<Segment<C>>,
+    throughput: Vec3,
+    estimate: Vec3,
+}
+
+impl<C> Default for PathRecorder<C> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<C> PathRecorder<C> {
+    /// An empty recorder.
+    pub fn new() -> Self {
+        Self {
+            segments: Vec::new(),
+            throughput: Vec3::ONE,
+            estimate: Vec3::ZERO,
+        }
+    }
+
+    /// Starts a new path (keeps the storage).
+    pub fn clear(&mut self) {
+        self.segments.clear();
+        self.throughput = Vec3::ONE;
+        self.estimate = Vec3::ZERO;
+    }
+
+    /// The path throughput so far: the product of the segments' weights.
+    #[inline]
+    pub fn throughput(&self) -> Vec3 {
+        self.throughput
+    }
+
+    /// Radiance the path found at its current end, MIS-weighted and not
+    /// multiplied by the throughput (the recorder does that): an emitter
+    /// hit `Le w`, or next-event estimation's `f cos Le w / p`. Non-finite
+    /// values are ignored (they would poison the pixel and every record).
+    #[inline]
+    pub fn add_radiance(&mut self, radiance: Vec3) {
+        if !radiance.is_finite() {
+            return;
+        }
+        self.estimate += self.throughput * radiance;
+        if let Some(last) = self.segments.last_mut() {
+            last.found += last.factor * radiance;
+        }
+    }
+
+    /// The path leaves `position` along `direction`, sampled with the
+    /// mixture pdf `pdf` (BSDF pdf `bsdf_pdf`, guide pdf `guide_pdf`), with
+    /// throughput factor `weight = f cos / pdf`. `cell` is what the
+    /// renderer located there, handed back when the segment is recorded.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn push_segment(
+        &mut self,
+        cell: C,
+        position: Vec3,
+        direction: Vec3,
+        pdf: f32,
+        bsdf_pdf: f32,
+        guide_pdf: f32,
+        weight: Vec3,
+    ) {
+        self.throughput *= weight;
+        self.segments.push(Segment {
+            cell,
+            position,
+            direction,
+            pdf,
+            bsdf_pdf,
+            guide_pdf,
+            weight,
+            found: Vec3::ZERO,
+            incident: Vec3::ZERO,
+            factor: Vec3::ONE,
+        });
+    }
+
+    /// A scattering that guiding does not learn from (a specular bounce):
+    /// only the throughput changes. Radiance found after it still reaches
+    /// the earlier segments, through `weight`.
+    #[inline]
+    pub fn scatter_unrecorded(&mut self, weight: Vec3) {
+        self.throughput *= weight;
+        if let Some(last) = self.segments.last_mut() {
+            last.factor *= weight;
+        }
+    }
+
+    /// The pixel estimate: every radiance found, times the throughput at
+    /// the moment it was found.
+    #[inline]
+    pub fn estimate(&self) -> Vec3 {
+        self.estimate
+    }
+
+    /// The recorded segments (their `incident` radiance is filled by
+    /// [`PathRecorder::finish`]).
+    pub fn segments(&self) -> &[Segment<C>] {
+        &self.segments
+    }
+
+    /// Computes the radiance that arrived along every segment and hands
+    /// each one with a finite, non-negative value to `records`.
+    pub fn finish<S: RadianceRecords<C> + ?Sized, R: Rng + ?Sized>(
+        &mut self,
+        records: &S,
+        rng: &mut R,
+    ) {
+        // L_i = found_i + factor_i w_(i+1) L_(i+1), from the last segment.
+        let mut after = Vec3::ZERO;
+        let mut next_weight = Vec3::ZERO;
+        for s in self.segments.iter_mut().rev() {
+            after = s.found + s.factor * next_weight * after;
+            s.incident = after;
+            next_weight = s.weight;
+        }
+        for s in &self.segments {
+            if s.incident.is_finite() {
+                let radiance = luminance(s.incident);
+                records.record(s, radiance, luminance(s.weight * s.incident), rng);
+            }
+        }
+    }
+}
