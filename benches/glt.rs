@@ -1,6 +1,6 @@
 //! Microbenchmarks of the Guiding Light Tree: `sample`, `pmf` and both per
 //! call for sigma in {0.05, 0.01, 0.002} and 1e2..1e6 lights, beside
-//! tree-by-energy sampling on the same tree; `splat` per call; `refine` per
+//! tree-by-power sampling on the same tree; `splat` per call; `refine` per
 //! cell; bytes per cut node and per cell (printed).
 //!
 //! Cuts are trained with synthetic splats (a fragmented visible subset with
@@ -10,15 +10,15 @@
 //! `GLT_BENCH_LIGHTS=100,10000` to build and train only those sizes (the
 //! 1e6 scene takes ~30 s to set up).
 //!
-//! `cut-untrained/sample+pmf` samples exactly the energy distribution (the
-//! initial cut), so its ratio to `energy/sample+pmf` is the rule's own
+//! `cut-untrained/sample+pmf` samples exactly the power distribution (the
+//! initial cut), so its ratio to `power/sample+pmf` is the rule's own
 //! overhead; trained cuts choose other leaves, whose path lengths are
 //! printed beside the tree's.
 
 use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use guiding::glt::{BelowCut, CutConfig, CutNode, Glt, GltConfig, GuidingCut, GuidingTree};
-use guiding::light_sampler::EnergyTreeSampler;
+use guiding::light_sampler::PowerTreeSampler;
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Aabb;
 use guiding::{Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext};
@@ -112,7 +112,7 @@ fn bench_sampling(c: &mut Criterion) {
     let ctx = ShadingContext::on_surface(POINT, Vec3::Y);
     for n in light_counts() {
         let (lights, tree) = scene(n);
-        let energy = EnergyTreeSampler::new(&tree);
+        let power = PowerTreeSampler::new(&tree);
         let u = us(n);
         let mut group = c.benchmark_group(format!("glt/{n}"));
         let mut k = 0usize;
@@ -120,27 +120,25 @@ fn bench_sampling(c: &mut Criterion) {
             k = (k + 1) & 4095;
             k
         };
-        group.bench_function("energy/sample", |b| {
-            b.iter(|| energy.sample(black_box(&ctx), black_box(u[next()])))
+        group.bench_function("power/sample", |b| {
+            b.iter(|| power.sample(black_box(&ctx), black_box(u[next()])))
         });
         let mut emitted: Vec<LightId> = u
             .iter()
-            .filter_map(|&x| energy.sample(&ctx, x).map(|s| s.light))
+            .filter_map(|&x| power.sample(&ctx, x).map(|s| s.light))
             .collect();
         emitted.truncate(4096);
-        group.bench_function("energy/pmf", |b| {
-            b.iter(|| energy.pmf(black_box(&ctx), black_box(emitted[next() % emitted.len()])))
+        group.bench_function("power/pmf", |b| {
+            b.iter(|| power.pmf(black_box(&ctx), black_box(emitted[next() % emitted.len()])))
         });
-        group.bench_function("energy/sample+pmf", |b| {
+        group.bench_function("power/sample+pmf", |b| {
             b.iter(|| {
-                let s = energy
-                    .sample(black_box(&ctx), black_box(u[next()]))
-                    .unwrap();
-                energy.pmf(&ctx, s.light)
+                let s = power.sample(black_box(&ctx), black_box(u[next()])).unwrap();
+                power.pmf(&ctx, s.light)
             })
         });
-        // The untrained cut samples exactly the energy distribution: the
-        // same leaves, so the same path lengths; the ratio to `energy` is
+        // The untrained cut samples exactly the power distribution: the
+        // same leaves, so the same path lengths; the ratio to `power` is
         // the rule's own overhead. Trained cuts choose other (often deeper)
         // leaves, which costs more for any sampler.
         let fresh_guide = GuidingTree::new(&tree, CutConfig::default()).unwrap();
@@ -161,7 +159,7 @@ fn bench_sampling(c: &mut Criterion) {
             lights.iter().map(|&l| depth(l)).sum::<usize>() as f64 / lights.len().max(1) as f64
         };
         eprintln!(
-            "glt/{n}: tree depth {}, mean sampled depth by energy {:.1}",
+            "glt/{n}: tree depth {}, mean sampled depth by power {:.1}",
             tree.depth(),
             mean_depth(&emitted)
         );
@@ -176,14 +174,14 @@ fn bench_sampling(c: &mut Criterion) {
                 .iter()
                 .filter_map(|&x| guide.sample(&cut, &ctx, x).map(|s| s.light))
                 .collect();
-            // Tree-by-energy evaluated on the leaves the trained cut picks:
+            // Tree-by-power evaluated on the leaves the trained cut picks:
             // the same path lengths as the cut's own pmf.
             eprintln!(
                 "glt/{n} sigma={sigma}: mean sampled depth {:.1}",
                 mean_depth(&sampled)
             );
-            group.bench_function(BenchmarkId::new("energy/pmf-of-cut-samples", sigma), |b| {
-                b.iter(|| energy.pmf(black_box(&ctx), black_box(sampled[next() % sampled.len()])))
+            group.bench_function(BenchmarkId::new("power/pmf-of-cut-samples", sigma), |b| {
+                b.iter(|| power.pmf(black_box(&ctx), black_box(sampled[next() % sampled.len()])))
             });
             let m = cut.memory();
             eprintln!(
@@ -217,7 +215,7 @@ fn bench_sampling(c: &mut Criterion) {
         }
         if n == 10_000 {
             // Variants at one size: the paper's rules (one distribution per
-            // cell, energy below the cut and as the prior), without the
+            // cell, power below the cut and as the prior), without the
             // prior mixture, with importance below the cut only; and the
             // whole Glt (spatial lookup included).
             for (name, config) in [
@@ -278,12 +276,12 @@ fn bench_sampling(c: &mut Criterion) {
                     glt.pmf(&ctx, s.light)
                 })
             });
-            group.bench_function("energy/sample+pmf-moving", |b| {
+            group.bench_function("power/sample+pmf-moving", |b| {
                 b.iter(|| {
                     let i = next();
                     let ctx = ShadingContext::on_surface(points[i], Vec3::Y);
-                    let s = energy.sample(black_box(&ctx), black_box(u[i])).unwrap();
-                    energy.pmf(&ctx, s.light)
+                    let s = power.sample(black_box(&ctx), black_box(u[i])).unwrap();
+                    power.pmf(&ctx, s.light)
                 })
             });
             let mut splat_rng = Rand::new(4);

@@ -9,7 +9,7 @@ use criterion::{
 };
 use glam::Vec3;
 use guiding::light_sampler::{
-    EnergyTreeSampler, ImportanceTreeSampler, PowerSampler, UniformSampler, WithEnvironment,
+    ImportanceTreeSampler, PowerSampler, PowerTreeSampler, UniformSampler, WithEnvironment,
 };
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::{Aabb, LightCone};
@@ -116,8 +116,8 @@ fn light_samplers(c: &mut Criterion) {
         bench_sampler(&mut group, "power", &PowerSampler::new(&emitters), &queries);
         bench_sampler(
             &mut group,
-            "energy_tree",
-            &EnergyTreeSampler::new(&tree),
+            "power_tree",
+            &PowerTreeSampler::new(&tree),
             &queries,
         );
         bench_sampler(

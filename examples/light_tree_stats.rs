@@ -1,6 +1,6 @@
 //! Builds a light tree over a generated scene of 100k emitters (quads,
 //! spheres, point and spot lights with powers over five decades), prints its
-//! shape, memory and build time, then checks the tree-by-energy sampler:
+//! shape, memory and build time, then checks the tree-by-power sampler:
 //! draws light samples, compares how often each power class is chosen with
 //! the probability `pmf` assigns it (chi-square test), checks that `sample`
 //! and `pmf` agree exactly and that the pmf sums to one.
@@ -12,7 +12,7 @@
 //! ```
 
 use glam::Vec3;
-use guiding::light_sampler::EnergyTreeSampler;
+use guiding::light_sampler::PowerTreeSampler;
 use guiding::light_tree::BuildHeuristic;
 use guiding::{LightHierarchy, LightId, LightSampler, LightTree, ShadingContext};
 use std::process::ExitCode;
@@ -70,9 +70,9 @@ fn main() -> ExitCode {
         tree.bytes() as f64 / (1u64 << 20) as f64
     );
 
-    // The tree-by-energy sampler: the probability of each emitter should be
+    // The tree-by-power sampler: the probability of each emitter should be
     // its share of the total power, whatever the shading point.
-    let sampler = EnergyTreeSampler::new(&tree);
+    let sampler = PowerTreeSampler::new(&tree);
     let ctx = ShadingContext::on_surface(Vec3::new(1.0, -3.0, 2.0), Vec3::Y);
     let mut failures = Vec::new();
 
@@ -117,7 +117,7 @@ fn main() -> ExitCode {
 
     println!();
     println!(
-        "tree-by-energy sampler, {SAMPLES} samples ({:.0} ns per sample + pmf)",
+        "tree-by-power sampler, {SAMPLES} samples ({:.0} ns per sample + pmf)",
         sample_time.as_secs_f64() * 1e9 / SAMPLES as f64
     );
     println!(

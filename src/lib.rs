@@ -76,7 +76,7 @@ pub use dropped::DroppedSplats;
 pub use emitter::{Emitter, Emitters, ShadingContext};
 pub use error::{ConfigError, Error};
 pub use light_sampler::{
-    EnergyTreeSampler, ImportanceTreeSampler, LightId, LightSample, LightSampler, PowerSampler,
+    ImportanceTreeSampler, LightId, LightSample, LightSampler, PowerSampler, PowerTreeSampler,
     UniformSampler, WithEnvironment,
 };
 pub use light_tree::{LightHierarchy, LightTree};

@@ -10,7 +10,7 @@ use guiding::field::{FieldConfig, GuidingField};
 use guiding::glt::{CutConfig, Glt, GltConfig, GuidingTree};
 use guiding::light_tree::BuildHeuristic;
 use guiding::{
-    EnergyTreeSampler, ImportanceTreeSampler, LightId, LightSampler, LightTree, PowerSampler,
+    ImportanceTreeSampler, LightId, LightSampler, LightTree, PowerSampler, PowerTreeSampler,
     ShadingContext, UniformSampler, WithEnvironment,
 };
 
@@ -69,7 +69,7 @@ fn every_sampler_has_the_same_edges() {
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
     check("uniform", &UniformSampler::new(lights.len()), n);
     check("power", &PowerSampler::new(&lights), n);
-    check("energy tree", &EnergyTreeSampler::new(&tree), n);
+    check("power tree", &PowerTreeSampler::new(&tree), n);
     check("importance tree", &ImportanceTreeSampler::new(&tree), n);
     check(
         "with environment",

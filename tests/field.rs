@@ -226,7 +226,7 @@ fn equals_a_glt_fed_the_same_light_splats() {
         GltConfig {
             cut,
             spatial_threshold: 200.0,
-            spatial_budget: None,
+            max_bytes: None,
             filter: SpatialFilter::StochasticBox,
         },
     )
@@ -341,7 +341,7 @@ proptest! {
         let config = FieldConfig {
             cut: CutConfig {
                 environment: env,
-                below_cut: if importance { BelowCut::Importance } else { BelowCut::Energy },
+                below_cut: if importance { BelowCut::Importance } else { BelowCut::Power },
                 ..CutConfig::default()
             },
             ..config_with(60.0, SdTreeConfig::improved())

@@ -81,7 +81,7 @@ fn pmf_total<H: LightHierarchy + ?Sized>(
 /// What the total pmf must be: 1 when anything can be sampled.
 fn expected_total<H: LightHierarchy + ?Sized>(guide: &GuidingTree<&H>) -> f64 {
     let tree = guide.light_tree();
-    let emitters = tree.root().is_some_and(|r| tree.energy(r) > 0.0);
+    let emitters = tree.root().is_some_and(|r| tree.power(r) > 0.0);
     let env = guide.config().environment.is_some();
     if emitters || env { 1.0 } else { 0.0 }
 }
@@ -121,9 +121,9 @@ fn lights_in_box(rng: &mut Rand, n: usize, r: f32) -> Vec<Emitter> {
 }
 
 const ALL_CONFIGS: [(BelowCut, SplitPrior); 4] = [
-    (BelowCut::Energy, SplitPrior::Energy),
-    (BelowCut::Energy, SplitPrior::Half),
-    (BelowCut::Importance, SplitPrior::Energy),
+    (BelowCut::Power, SplitPrior::Power),
+    (BelowCut::Power, SplitPrior::Half),
+    (BelowCut::Importance, SplitPrior::Power),
     (BelowCut::Importance, SplitPrior::Half),
 ];
 
@@ -253,7 +253,7 @@ fn config_strategy() -> impl Strategy<Value = CutConfig> {
                     prior: if prior_imp {
                         Prior::Importance
                     } else {
-                        Prior::Energy
+                        Prior::Power
                     },
                 }
             },
@@ -358,7 +358,7 @@ fn learns_the_visible_subset() {
         .sum();
     for (below_cut, split_prior) in ALL_CONFIGS {
         for alpha in [0.0, 0.1, 0.3] {
-            // The energy prior, which `prior_outside` is computed for.
+            // The power prior, which `prior_outside` is computed for.
             let config = CutConfig {
                 alpha,
                 below_cut,
@@ -401,21 +401,21 @@ fn learns_the_visible_subset() {
     }
 }
 
-/// With `SplitPrior::Energy` a freshly split cluster samples exactly as
+/// With `SplitPrior::Power` a freshly split cluster samples exactly as
 /// before the split; with `Half` it does not (the test can tell them apart).
 #[test]
-fn energy_split_prior_preserves_the_distribution() {
+fn power_split_prior_preserves_the_distribution() {
     let mut rng = Rand::new(3);
     let lights = lights_in_box(&mut rng, 200, 5.0);
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
     let ctx = ShadingContext::at(Vec3::ZERO);
     let [l, r] = tree.children(tree.root().unwrap()).unwrap();
-    for prior in [SplitPrior::Energy, SplitPrior::Half] {
+    for prior in [SplitPrior::Power, SplitPrior::Half] {
         let config = CutConfig {
             alpha: 0.0,
             split_prior: prior,
             sigma: 0.002,
-            // The paper's rules: energy below the cut, one distribution per
+            // The paper's rules: power below the cut, one distribution per
             // cell, rebuild from any data (here two splats).
             min_splats: 0,
             ..CutConfig::default().with_paper_rules()
@@ -425,7 +425,7 @@ fn energy_split_prior_preserves_the_distribution() {
         let before: Vec<f64> = (0..200)
             .map(|e| guide.pmf_exact(&cut, &ctx, LightId::Emitter(e)))
             .collect();
-        // Sums exactly in the ratio of the root's children's energies: the
+        // Sums exactly in the ratio of the root's children's powers: the
         // root keeps its p_left, every slot below is split afresh.
         let first_light = |mut n: u32| {
             while let Some([c, _]) = tree.children(n) {
@@ -433,8 +433,8 @@ fn energy_split_prior_preserves_the_distribution() {
             }
             tree.emitter(n).unwrap()
         };
-        guide.splat(&cut, LightId::Emitter(first_light(l)), tree.energy(l));
-        guide.splat(&cut, LightId::Emitter(first_light(r)), tree.energy(r));
+        guide.splat(&cut, LightId::Emitter(first_light(l)), tree.power(l));
+        guide.splat(&cut, LightId::Emitter(first_light(r)), tree.power(r));
         guide.refine(&mut cut);
         assert!(cut.nodes().len() > 50, "{}", cut.nodes().len());
         assert_valid_cut(&tree, &cut);
@@ -445,7 +445,7 @@ fn energy_split_prior_preserves_the_distribution() {
             })
             .fold(0.0, f64::max);
         match prior {
-            SplitPrior::Energy => assert!(worst < 1e-5, "relative change {worst}"),
+            SplitPrior::Power => assert!(worst < 1e-5, "relative change {worst}"),
             SplitPrior::Half => assert!(worst > 0.1, "relative change {worst}"),
         }
     }
@@ -532,7 +532,7 @@ fn splits_to_leaves_and_merges_back() {
     assert!(wide > 40, "{wide}");
     // One emitter holds everything: the cut becomes its path (single
     // emitter at the end), all else merges. The first pass splits the old
-    // cluster of emitter 17 by the energy prior; the second learns that its
+    // cluster of emitter 17 by the power prior; the second learns that its
     // siblings got nothing.
     for _ in 0..2 {
         for _ in 0..10 {
@@ -673,23 +673,23 @@ fn estimate_is_unbiased_with_the_defensive_mixture() {
 /// last two at depth `n - 1`). Inner `k` = node `2k`, leaf `k` = node
 /// `2k + 1`, the last leaf is node `2n - 2`.
 struct Chain {
-    energy: Vec<f32>,
+    power: Vec<f32>,
     subtree: Vec<f32>,
 }
 
 impl Chain {
-    fn new(energy: Vec<f32>) -> Self {
-        let n = energy.len();
+    fn new(power: Vec<f32>) -> Self {
+        let n = power.len();
         let mut subtree = vec![0.0f32; n];
         let mut acc = 0.0f64;
         for k in (0..n).rev() {
-            acc += energy[k] as f64;
+            acc += power[k] as f64;
             subtree[k] = acc as f32;
         }
-        Self { energy, subtree }
+        Self { power, subtree }
     }
     fn n(&self) -> u32 {
-        self.energy.len() as u32
+        self.power.len() as u32
     }
     fn leaf_node(&self, e: u32) -> u32 {
         if e == self.n() - 1 { 2 * e } else { 2 * e + 1 }
@@ -717,9 +717,9 @@ impl LightHierarchy for Chain {
             Some(node - 2)
         }
     }
-    fn energy(&self, node: u32) -> f32 {
+    fn power(&self, node: u32) -> f32 {
         match self.emitter(node) {
-            Some(e) => self.energy[e as usize],
+            Some(e) => self.power[e as usize],
             None => self.subtree[(node / 2) as usize],
         }
     }
@@ -728,7 +728,7 @@ impl LightHierarchy for Chain {
             bounds: Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0)),
             cone: LightCone::SPHERE,
             two_sided: false,
-            energy: self.energy(node),
+            power: self.power(node),
         }
     }
     fn emitter(&self, node: u32) -> Option<u32> {
@@ -745,16 +745,16 @@ impl LightHierarchy for Chain {
         (emitter < self.n()).then(|| self.leaf_node(emitter))
     }
     fn node_count(&self) -> usize {
-        2 * self.energy.len() - 1
+        2 * self.power.len() - 1
     }
     fn emitter_count(&self) -> usize {
-        self.energy.len()
+        self.power.len()
     }
 }
 
 /// One uniform number per descent stays exact in distribution through the
 /// cut and the tree together, 100 levels deep: the cut covers the first 70
-/// levels, energy descent the last 30. Chi-square over the 100 leaves
+/// levels, power descent the last 30. Chi-square over the 100 leaves
 /// against `pmf()`, with f32 and f64 numbers. (An f32 rescaling, as in the
 /// paper's code, never reaches leaves past depth ~24 and fails this.)
 #[test]
@@ -771,7 +771,7 @@ fn deep_chain_is_exact_in_distribution() {
         let mut cut = guide.new_cut();
         // Learned targets: large for k < 70 (skewed), small tail whose total
         // share (< sigma) ends the cut at depth 70. Fresh half splits reach
-        // a few levels deeper per pass, energy splits all the way.
+        // a few levels deeper per pass, power splits all the way.
         for _ in 0..16 {
             for k in 0..n {
                 let t = if k < 70 {
@@ -933,7 +933,7 @@ fn zero_power_subtrees() {
         .collect();
     let tree = LightTree::build(&lights, BuildHeuristic::Balanced).unwrap();
     let [l, r] = tree.children(tree.root().unwrap()).unwrap();
-    assert!(tree.energy(l) == 0.0 || tree.energy(r) == 0.0);
+    assert!(tree.power(l) == 0.0 || tree.power(r) == 0.0);
     for (below_cut, split_prior) in ALL_CONFIGS {
         let config = CutConfig {
             below_cut,
@@ -960,7 +960,7 @@ fn zero_power_subtrees() {
     }
 }
 
-/// The energy prior keeps `f32` relative precision on both sides of every
+/// The power prior keeps `f32` relative precision on both sides of every
 /// split: lights with 1e-12 and 3e-10 of the total power keep their floor
 /// `alpha * power / total` after the cut learned only the bright one (a
 /// plain `f32` `p_left` would round their side to 0).
@@ -972,7 +972,7 @@ fn prior_floor_survives_extreme_ratios() {
         Emitter::point(Vec3::Y, 1.0),
     ];
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
-    // The paper's rules (the energy prior), rebuilding from any data (one
+    // The paper's rules (the power prior), rebuilding from any data (one
     // splat per pass).
     let config = CutConfig {
         min_splats: 0,
@@ -1140,7 +1140,7 @@ fn cut_node_is_twelve_bytes() {
 }
 
 /// The test hierarchy itself: leaf `k` at depth `k + 1`, parents and
-/// children agree, energies add up.
+/// children agree, powers add up.
 #[test]
 fn chain_hierarchy_is_consistent() {
     let chain = Chain::new((0..80).map(|k| k as f32).collect());
@@ -1150,7 +1150,7 @@ fn chain_hierarchy_is_consistent() {
         assert_eq!(chain.emitter(path.leaf()), Some(k));
     }
     assert_eq!(chain.path(79).unwrap().depth(), 79);
-    assert_eq!(chain.energy(0), (0..80).sum::<u32>() as f32);
+    assert_eq!(chain.power(0), (0..80).sum::<u32>() as f32);
     for node in 1..chain.node_count() as u32 {
         let parent = chain.parent(node).unwrap();
         assert!(chain.children(parent).unwrap().contains(&node));

@@ -80,8 +80,8 @@ fn measure_defaults() {
         .map(|_| Vec3::new(rng.f() * 40.0 - 20.0, 0.0, rng.f() * 40.0 - 20.0))
         .collect();
     for alpha in [0.05, 0.1, 0.2, 0.3, 0.5, 1.0] {
-        for below_cut in [BelowCut::Energy, BelowCut::Importance] {
-            for split_prior in [SplitPrior::Energy, SplitPrior::Half] {
+        for below_cut in [BelowCut::Power, BelowCut::Importance] {
+            for split_prior in [SplitPrior::Power, SplitPrior::Half] {
                 let config = GltConfig {
                     cut: CutConfig {
                         below_cut,

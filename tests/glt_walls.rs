@@ -135,7 +135,7 @@ fn dim_room_ratio(config: CutConfig, filter: SpatialFilter) -> f64 {
         GltConfig {
             cut: config,
             spatial_threshold: 400.0,
-            spatial_budget: None,
+            max_bytes: None,
             filter,
         },
     )

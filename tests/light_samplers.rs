@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 use guiding::light_sampler::{
-    EnergyTreeSampler, ImportanceTreeSampler, PowerSampler, UniformSampler, WithEnvironment,
+    ImportanceTreeSampler, PowerSampler, PowerTreeSampler, UniformSampler, WithEnvironment,
     importance,
 };
 use guiding::light_tree::{BuildHeuristic, LightHierarchy, NodeBounds};
@@ -165,7 +165,7 @@ fn all_samplers<'a>(
     vec![
         ("uniform", Box::new(UniformSampler::new(emitters.len()))),
         ("power", Box::new(PowerSampler::new(emitters))),
-        ("energy tree", Box::new(EnergyTreeSampler::new(tree))),
+        ("power tree", Box::new(PowerTreeSampler::new(tree))),
         (
             "importance tree",
             Box::new(ImportanceTreeSampler::new(tree)),
@@ -344,17 +344,17 @@ proptest! {
         check_scene(spec, heuristic(h), 0.25, 8)?;
     }
 
-    /// The energy-tree descent is exactly the inverse CDF of the leaves, in
+    /// The power-tree descent is exactly the inverse CDF of the leaves, in
     /// tree order, and its pmf is exactly the product of the f64 child
     /// probabilities.
     #[test]
-    fn energy_tree_is_the_inverse_cdf(spec in scene_spec(), h in 0usize..4) {
+    fn power_tree_is_the_inverse_cdf(spec in scene_spec(), h in 0usize..4) {
         let spec = SceneSpec { count: spec.count.min(500), ..spec };
         let emitters = random_emitters(spec);
         let tree = LightTree::build(&emitters, heuristic(h)).unwrap();
-        let s = EnergyTreeSampler::new(&tree);
+        let s = PowerTreeSampler::new(&tree);
         let ctx = ShadingContext::at(Vec3::ONE);
-        check_inverse_cdf(&s, &ctx, &energy_intervals(&tree));
+        check_inverse_cdf(&s, &ctx, &power_intervals(&tree));
     }
 }
 
@@ -521,14 +521,14 @@ fn chi_square_rejects_a_wrong_pmf() {
 struct Chain {
     children: Vec<Option<[u32; 2]>>,
     parent: Vec<Option<u32>>,
-    energy: Vec<f32>,
+    power: Vec<f32>,
     emitter: Vec<Option<u32>>,
     leaf_of: Vec<u32>,
 }
 
 impl Chain {
-    fn new(leaf_energy: &[f32], zigzag: bool) -> Self {
-        let n = leaf_energy.len();
+    fn new(leaf_power: &[f32], zigzag: bool) -> Self {
+        let n = leaf_power.len();
         assert!(n >= 2);
         let inner = n - 1;
         let total = inner + n;
@@ -536,13 +536,13 @@ impl Chain {
         let mut c = Chain {
             children: vec![None; total],
             parent: vec![None; total],
-            energy: vec![0.0; total],
+            power: vec![0.0; total],
             emitter: vec![None; total],
             leaf_of: (0..n).map(leaf).collect(),
         };
-        for (k, &e) in leaf_energy.iter().enumerate() {
+        for (k, &e) in leaf_power.iter().enumerate() {
             c.emitter[leaf(k) as usize] = Some(k as u32);
-            c.energy[leaf(k) as usize] = e;
+            c.power[leaf(k) as usize] = e;
         }
         for k in 0..inner {
             let deeper = if k + 1 < inner {
@@ -559,10 +559,10 @@ impl Chain {
             c.parent[pair[0] as usize] = Some(k as u32);
             c.parent[pair[1] as usize] = Some(k as u32);
         }
-        let mut below = leaf_energy[n - 1] as f64;
+        let mut below = leaf_power[n - 1] as f64;
         for k in (0..inner).rev() {
-            below += leaf_energy[k] as f64;
-            c.energy[k] = below as f32;
+            below += leaf_power[k] as f64;
+            c.power[k] = below as f32;
         }
         c
     }
@@ -578,15 +578,15 @@ impl LightHierarchy for Chain {
     fn parent(&self, node: u32) -> Option<u32> {
         *self.parent.get(node as usize)?
     }
-    fn energy(&self, node: u32) -> f32 {
-        self.energy.get(node as usize).copied().unwrap_or(0.0)
+    fn power(&self, node: u32) -> f32 {
+        self.power.get(node as usize).copied().unwrap_or(0.0)
     }
     fn node_bounds(&self, node: u32) -> NodeBounds {
         NodeBounds {
             bounds: Aabb::from_point(Vec3::ZERO),
             cone: LightCone::SPHERE,
             two_sided: false,
-            energy: self.energy(node),
+            power: self.power(node),
         }
     }
     fn emitter(&self, node: u32) -> Option<u32> {
@@ -605,14 +605,14 @@ impl LightHierarchy for Chain {
 
 /// (emitter, C, p) of every leaf in the descent's left-to-right order, with
 /// p multiplied root-down exactly as the descent does (`w / (wl + wr)` in
-/// f64 from the `f32` subtree energies) and C the running sum of the p's.
-fn energy_intervals<H: LightHierarchy>(t: &H) -> Vec<(u32, f64, f64)> {
+/// f64 from the `f32` subtree powers) and C the running sum of the p's.
+fn power_intervals<H: LightHierarchy>(t: &H) -> Vec<(u32, f64, f64)> {
     let mut out = Vec::new();
     let Some(root) = t.root() else {
         return out;
     };
     let mut c = 0.0;
-    let mut stack = vec![(root, if t.energy(root) > 0.0 { 1.0 } else { 0.0 })];
+    let mut stack = vec![(root, if t.power(root) > 0.0 { 1.0 } else { 0.0 })];
     while let Some((node, p)) = stack.pop() {
         match t.children(node) {
             None => {
@@ -620,7 +620,7 @@ fn energy_intervals<H: LightHierarchy>(t: &H) -> Vec<(u32, f64, f64)> {
                 c += p;
             }
             Some([l, r]) => {
-                let (wl, wr) = (t.energy(l) as f64, t.energy(r) as f64);
+                let (wl, wr) = (t.power(l) as f64, t.power(r) as f64);
                 let total = wl + wr;
                 let (pl, pr) = if total > 0.0 {
                     (wl / total, wr / total)
@@ -707,8 +707,8 @@ fn check_inverse_cdf(
     (checked, smallest)
 }
 
-/// Leaf energies 2^-k: leaf k has pmf ~2^-(k+1), down to ~4e-31 at depth 100.
-fn halving_energies(n: usize) -> Vec<f32> {
+/// Leaf powers 2^-k: leaf k has pmf ~2^-(k+1), down to ~4e-31 at depth 100.
+fn halving_powers(n: usize) -> Vec<f32> {
     (0..n).map(|k| 2f32.powi(-(k as i32))).collect()
 }
 
@@ -716,11 +716,11 @@ fn halving_energies(n: usize) -> Vec<f32> {
 fn deep_chain_is_the_exact_inverse_cdf() {
     let ctx = ShadingContext::at(Vec3::X);
     for zigzag in [false, true] {
-        let chain = Chain::new(&halving_energies(101), zigzag);
-        let intervals = energy_intervals(&chain);
+        let chain = Chain::new(&halving_powers(101), zigzag);
+        let intervals = power_intervals(&chain);
         assert_eq!(intervals.len(), 101);
         let samplers: [(&str, &dyn LightSampler); 2] = [
-            ("energy", &EnergyTreeSampler::new(&chain)),
+            ("power", &PowerTreeSampler::new(&chain)),
             ("importance", &ImportanceTreeSampler::new(&chain)),
         ];
         for (name, s) in samplers {
@@ -759,8 +759,8 @@ fn deep_fit(what: &str, s: &dyn LightSampler, intervals: &[(u32, f64, f64)], top
 
 #[test]
 fn deep_chain_chi_square() {
-    let chain = Chain::new(&halving_energies(101), false);
-    let intervals = energy_intervals(&chain);
+    let chain = Chain::new(&halving_powers(101), false);
+    let intervals = power_intervals(&chain);
     // [0, top) holds exactly the leaves at depth >= 60.
     let top: f64 = intervals
         .iter()
@@ -769,7 +769,7 @@ fn deep_chain_chi_square() {
         .sum();
     assert!(top > 0.0 && top < 1e-17);
     let samplers: [(&str, &dyn LightSampler); 2] = [
-        ("energy", &EnergyTreeSampler::new(&chain)),
+        ("power", &PowerTreeSampler::new(&chain)),
         ("importance", &ImportanceTreeSampler::new(&chain)),
     ];
     for (i, (name, s)) in samplers.into_iter().enumerate() {
@@ -811,14 +811,14 @@ fn deep_light_tree_is_exact() {
     let emitters = skewed_emitters(100);
     let tree = LightTree::build(&emitters, BuildHeuristic::Sarh).unwrap();
     assert!(tree.depth() > 64, "depth {}", tree.depth());
-    let intervals = energy_intervals(&tree);
-    let s = EnergyTreeSampler::new(&tree);
+    let intervals = power_intervals(&tree);
+    let s = PowerTreeSampler::new(&tree);
     let ctx = ShadingContext::at(Vec3::X);
     let (checked, smallest) = check_inverse_cdf(&s, &ctx, &intervals);
     assert!(checked >= 40, "{checked}");
     assert!(smallest < 1e-15, "{smallest:e}");
     // Sorted by emitter for the chi-square's probability vector.
-    deep_fit("energy, skewed light tree", &s, &intervals, 1.0, 7);
+    deep_fit("power, skewed light tree", &s, &intervals, 1.0, 7);
     let imp = ImportanceTreeSampler::new(&tree);
     let ctxs = [
         ShadingContext::at(Vec3::X),
@@ -958,7 +958,7 @@ fn no_emitters() {
     let samplers: [Dyn; 4] = [
         Box::new(UniformSampler::new(0)),
         Box::new(PowerSampler::from_powers([])),
-        Box::new(EnergyTreeSampler::new(&tree)),
+        Box::new(PowerTreeSampler::new(&tree)),
         Box::new(ImportanceTreeSampler::new(&tree)),
     ];
     for s in &samplers {
@@ -989,7 +989,7 @@ fn one_emitter() {
     let inside = ShadingContext::at(Vec3::new(0.2, 0.3, 0.0));
     for ctx in [behind, inside] {
         for s in [
-            &EnergyTreeSampler::new(&tree) as &dyn LightSampler,
+            &PowerTreeSampler::new(&tree) as &dyn LightSampler,
             &ImportanceTreeSampler::new(&tree),
             &PowerSampler::new(&[quad][..]),
         ] {
@@ -1014,9 +1014,9 @@ fn two_emitters() {
     let ctx = ShadingContext::at(Vec3::ZERO);
     let pick = |s: &dyn LightSampler, i: u32| s.pmf(&ctx, LightId::Emitter(i));
     let power = PowerSampler::new(&emitters[..]);
-    let energy = EnergyTreeSampler::new(&tree);
+    let tree_sampler = PowerTreeSampler::new(&tree);
     let imp = ImportanceTreeSampler::new(&tree);
-    for s in [&power as &dyn LightSampler, &energy] {
+    for s in [&power as &dyn LightSampler, &tree_sampler] {
         assert_eq!((pick(s, 0), pick(s, 1)), (0.25, 0.75));
     }
     // Importance: 1/1^2 against 3/2^2.
@@ -1034,7 +1034,7 @@ fn all_zero_power() {
         let tree = LightTree::build(&emitters, heuristic(h)).unwrap();
         let samplers: [Dyn; 3] = [
             Box::new(PowerSampler::new(&emitters[..])),
-            Box::new(EnergyTreeSampler::new(&tree)),
+            Box::new(PowerTreeSampler::new(&tree)),
             Box::new(ImportanceTreeSampler::new(&tree)),
         ];
         for s in &samplers {
@@ -1069,7 +1069,7 @@ fn zero_power_subtree_is_never_chosen() {
     for h in 0..4 {
         let tree = LightTree::build(&emitters, heuristic(h)).unwrap();
         for s in [
-            &EnergyTreeSampler::new(&tree) as &dyn LightSampler,
+            &PowerTreeSampler::new(&tree) as &dyn LightSampler,
             &ImportanceTreeSampler::new(&tree),
             &PowerSampler::new(&emitters[..]),
         ] {
@@ -1088,10 +1088,10 @@ fn zero_power_subtree_is_never_chosen() {
 }
 
 /// Behind every (one-sided) light, every importance is zero: each node falls
-/// back to its children's energies, so the importance sampler becomes the
-/// energy sampler, bit for bit, and zero-power lights stay at pmf 0.
+/// back to its children's powers, so the importance sampler becomes the
+/// power sampler, bit for bit, and zero-power lights stay at pmf 0.
 #[test]
-fn behind_every_light_falls_back_to_energy() {
+fn behind_every_light_falls_back_to_power() {
     let mut rng = Pcg64::seed_from_u64(21);
     let emitters: Vec<Emitter> = (0..300)
         .map(|i| {
@@ -1112,7 +1112,7 @@ fn behind_every_light_falls_back_to_energy() {
     for h in 0..4 {
         let tree = LightTree::build(&emitters, heuristic(h)).unwrap();
         let imp = ImportanceTreeSampler::new(&tree);
-        let energy = EnergyTreeSampler::new(&tree);
+        let tree_sampler = PowerTreeSampler::new(&tree);
         for ctx in [
             // Far enough that even the root's bounds are all in front.
             ShadingContext::at(Vec3::new(0.5, 0.5, -1000.0)),
@@ -1120,12 +1120,12 @@ fn behind_every_light_falls_back_to_energy() {
         ] {
             for i in 0..emitters.len() as u32 {
                 let p = imp.pmf(&ctx, LightId::Emitter(i));
-                assert_eq!(p, energy.pmf(&ctx, LightId::Emitter(i)));
+                assert_eq!(p, tree_sampler.pmf(&ctx, LightId::Emitter(i)));
                 assert_eq!(p == 0.0, emitters[i as usize].power == 0.0);
             }
             for k in 0..100 {
                 let u = k as f32 / 100.0;
-                assert_eq!(imp.sample(&ctx, u), energy.sample(&ctx, u));
+                assert_eq!(imp.sample(&ctx, u), tree_sampler.sample(&ctx, u));
             }
         }
     }
@@ -1142,7 +1142,7 @@ fn huge_and_tiny_powers() {
     check_all(&emitters, &[on_top]);
     // The tiny ones are ~1e-61 of the total: pmf 0, never sampled.
     let tree = LightTree::build(&emitters, BuildHeuristic::Sarh).unwrap();
-    let s = EnergyTreeSampler::new(&tree);
+    let s = PowerTreeSampler::new(&tree);
     assert_eq!(s.pmf(&on_top, LightId::Emitter(15)), 0.0);
     assert!(s.pmf(&on_top, LightId::Emitter(5)) > 0.0);
 }
@@ -1223,7 +1223,7 @@ fn importance_is_never_nan_negative_or_spuriously_zero() {
             let i = importance(ctx, &b);
             assert!(i >= 0.0 && i.is_finite(), "{ctx:?} {b:?}: {i}");
             // Omnidirectional lights with power reach every finite point.
-            if b.energy > 0.0
+            if b.power > 0.0
                 && b.cone.is_sphere()
                 && ctx.normal.is_none()
                 && ctx.position.is_finite()
@@ -1239,7 +1239,7 @@ fn samplers_are_sync_and_work_across_threads() {
     fn assert_sync<T: Sync + Send>() {}
     assert_sync::<UniformSampler>();
     assert_sync::<PowerSampler>();
-    assert_sync::<EnergyTreeSampler<&'static LightTree>>();
+    assert_sync::<PowerTreeSampler<&'static LightTree>>();
     assert_sync::<ImportanceTreeSampler<&'static LightTree>>();
     assert_sync::<WithEnvironment<PowerSampler>>();
 
@@ -1302,7 +1302,7 @@ fn one_million_emitters() {
             }
         }
     }
-    // The full sum at one point (power and energy tree: the importance
+    // The full sum at one point (power and power tree: the importance
     // tree's sums are covered by the smaller scenes).
     for (name, s) in &samplers[1..3] {
         let sum: f64 = (0..N as u32)

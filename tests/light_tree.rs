@@ -1,4 +1,4 @@
-//! The global light tree: structure, bounds, energies, paths at any depth,
+//! The global light tree: structure, bounds, powers, paths at any depth,
 //! scale, hard cases and bad input.
 //!
 //! Every test goes through `check_tree`, which verifies the whole tree
@@ -143,7 +143,7 @@ fn check_tree(tree: &LightTree, emitters: &[Emitter]) -> Vec<usize> {
         assert_eq!(tree.root(), None);
         assert_eq!(tree.node_count(), 0);
         assert_eq!(tree.depth(), 0);
-        assert_eq!(tree.total_energy(), 0.0);
+        assert_eq!(tree.total_power(), 0.0);
         assert_eq!(tree.path(0), None);
         assert_eq!(tree.leaf(0), None);
         return Vec::new();
@@ -214,35 +214,35 @@ fn check_tree(tree: &LightTree, emitters: &[Emitter]) -> Vec<usize> {
             exact[i]
         );
         assert!(!d.bounds.min.is_nan() && !d.bounds.max.is_nan());
-        assert_eq!(d.energy, tree.energy(i as u32));
+        assert_eq!(d.power, tree.power(i as u32));
     }
     assert_eq!(tree.scene_bounds(), exact[0]);
 
-    // Energies: a leaf holds its emitter's power, an inner node the sum of
+    // Powers: a leaf holds its emitter's power, an inner node the sum of
     // its children within f32 rounding, the root the total.
     for node in 0..nodes as u32 {
-        let e = tree.energy(node);
-        assert!(e >= 0.0 && e.is_finite(), "node {node} energy {e}");
+        let e = tree.power(node);
+        assert!(e >= 0.0 && e.is_finite(), "node {node} power {e}");
         match tree.children(node) {
             None => {
                 let em = tree.emitter(node).unwrap() as usize;
-                assert_eq!(e, emitters[em].power, "leaf energy is the power");
+                assert_eq!(e, emitters[em].power, "leaf power is the power");
             }
             Some([l, r]) => {
-                let sum = tree.energy(l) as f64 + tree.energy(r) as f64;
+                let sum = tree.power(l) as f64 + tree.power(r) as f64;
                 let tol = 2.0 * f32::EPSILON as f64 * sum.max(e as f64) + 2.0 * 1e-45;
                 assert!(
                     (e as f64 - sum).abs() <= tol,
-                    "node {node}: energy {e} vs children {sum}"
+                    "node {node}: power {e} vs children {sum}"
                 );
             }
         }
     }
     let total: f64 = emitters.iter().map(|e| e.power as f64).sum();
-    let root_e = tree.total_energy() as f64;
+    let root_e = tree.total_power() as f64;
     assert!(
         (root_e - total).abs() <= total * 1e-6,
-        "total energy {root_e} vs {total}"
+        "total power {root_e} vs {total}"
     );
 
     // Paths: root to leaf, consistent with `children`, at any depth; every
@@ -394,7 +394,7 @@ fn no_emitters_give_an_empty_tree() {
         assert_eq!(tree.scene_bounds(), Aabb::EMPTY);
         assert_eq!(tree.children(0), None);
         assert_eq!(tree.parent(0), None);
-        assert_eq!(tree.energy(0), 0.0);
+        assert_eq!(tree.power(0), 0.0);
         assert!(tree.node_bounds(0).bounds.is_empty());
     }
 }
@@ -408,7 +408,7 @@ fn one_and_two_emitters() {
         assert_eq!(tree.depth(), 0);
         assert_eq!(tree.emitter(0), Some(0));
         assert_eq!(tree.path(0).unwrap().steps(), &[]);
-        assert_eq!(tree.total_energy(), 5.0);
+        assert_eq!(tree.total_power(), 5.0);
 
         let two = vec![
             quad(Vec3::ZERO, Vec3::Y, 1.0, 1.0),
@@ -417,7 +417,7 @@ fn one_and_two_emitters() {
         let tree = build(&two, h);
         check_tree(&tree, &two);
         assert_eq!(tree.depth(), 1);
-        assert_eq!(tree.total_energy(), 4.0);
+        assert_eq!(tree.total_power(), 4.0);
     }
 }
 
@@ -489,8 +489,8 @@ fn zero_powers() {
     for h in HEURISTICS {
         let tree = build(&all_zero, h);
         check_tree(&tree, &all_zero);
-        assert_eq!(tree.total_energy(), 0.0);
-        assert!((0..tree.node_count() as u32).all(|i| tree.energy(i) == 0.0));
+        assert_eq!(tree.total_power(), 0.0);
+        assert!((0..tree.node_count() as u32).all(|i| tree.power(i) == 0.0));
         assert!(tree.depth() <= 4 * ceil_log2(300), "{h:?}");
         let tree = build(&some_zero, h);
         check_tree(&tree, &some_zero);
@@ -510,7 +510,7 @@ fn tiny_and_subnormal_powers() {
     for h in HEURISTICS {
         let tree = build(&scene, h);
         check_tree(&tree, &scene);
-        assert!(tree.total_energy() > 0.0);
+        assert!(tree.total_power() > 0.0);
     }
 }
 
@@ -523,14 +523,14 @@ fn a_million_huge_powers_do_not_overflow() {
         e.power = 1e30;
     }
     let tree = build(&scene, BuildHeuristic::Balanced);
-    let rel = (tree.total_energy() as f64 - 1e36).abs() / 1e36;
-    assert!(rel < 1e-6, "total {}", tree.total_energy());
+    let rel = (tree.total_power() as f64 - 1e36).abs() / 1e36;
+    assert!(rel < 1e-6, "total {}", tree.total_power());
     let mut r = Rand::new(42);
     for _ in 0..1000 {
         let e = r.bits() % n as u32;
         let leaf = tree.leaf(e).unwrap();
         assert_eq!(tree.emitter(leaf), Some(e));
-        assert_eq!(tree.energy(leaf), 1e30);
+        assert_eq!(tree.power(leaf), 1e30);
     }
     // The power-aware heuristics, on a tenth of it, checked fully.
     scene.truncate(100_000);
@@ -553,9 +553,9 @@ fn power_overflow_only_when_the_total_overflows() {
         let ok = at(&[f32::MAX / 2.0, f32::MAX / 2.0]);
         let tree = build(&ok, h);
         check_tree(&tree, &ok);
-        assert_eq!(tree.total_energy(), f32::MAX);
+        assert_eq!(tree.total_power(), f32::MAX);
         let ok = at(&[f32::MAX, 0.0, 0.0]);
-        assert_eq!(build(&ok, h).total_energy(), f32::MAX);
+        assert_eq!(build(&ok, h).total_power(), f32::MAX);
         // Each power finite, the total not.
         for bad in [
             at(&[f32::MAX, f32::MAX]),

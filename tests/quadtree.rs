@@ -303,7 +303,7 @@ fn chi_square_detects_a_wrong_distribution() {
 }
 
 #[test]
-fn refinement_preserves_energy_merges_and_bounds_depth() {
+fn refinement_preserves_power_merges_and_bounds_depth() {
     for (i, filter) in FILTERS.into_iter().enumerate() {
         for seed in 0..3u64 {
             let mut r = rng(200 + seed);
@@ -324,7 +324,7 @@ fn refinement_preserves_energy_merges_and_bounds_depth() {
             let before_depth = tree.building_depth();
             tree.refine(&config);
 
-            // Energy: the sampling copy is what was collected, leaf by leaf.
+            // Power: the sampling copy is what was collected, leaf by leaf.
             assert_eq!(tree.sampling_total().to_bits(), total.to_bits());
             assert_eq!(tree.depth(), before_depth);
             let sampling = tree.sampling_leaves();
@@ -482,7 +482,7 @@ fn learns_three_directions() {
                 let k = r.next_u32() as usize % 3;
                 let jitter = 0.01 * unit(&mut r) * random_dir(&mut r);
                 tree.splat((dirs[k] + jitter).normalize(), (k + 1) as f32, filter);
-                // A dim background: 1% of the energy.
+                // A dim background: 1% of the power.
                 if r.next_u32() % 10 == 0 {
                     tree.splat(random_dir(&mut r), 0.2, filter);
                 }

@@ -316,7 +316,7 @@ fn bad_input_is_dropped_counted_and_never_stored() {
     assert_eq!(t.cell_count(), 1);
     assert_eq!(t.pdf(p, Vec3::X), UNIFORM_PDF);
     assert_eq!(t.bsdf_fraction(p), 0.5);
-    // Valid zero radiance counts weight, no energy.
+    // Valid zero radiance counts weight, no power.
     assert!(t.splat(p, d, 0.0, 1.0, &mut rng));
     assert_eq!(t.cell_at(p).unwrap().building_weight(), 1.0);
     t.reset_dropped_splats();

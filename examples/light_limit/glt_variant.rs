@@ -26,9 +26,9 @@ impl GltVariant {
     }
 
     /// Parses `spec`: space-separated `key=value` (sigma, alpha,
-    /// below=energy|importance, modulation=none|importance,
+    /// below=power|importance, modulation=none|importance,
     /// splat=radiance|contribution, filter=nearest|jitter,
-    /// prior=energy|importance, rules=paper (the paper's rules, see the
+    /// prior=power|importance, rules=paper (the paper's rules, see the
     /// render example's `--paper-rules`), min-splats, threshold,
     /// train-spp) applied in order to the defaults.
     pub fn parse(spec: &str, train_spp: u64) -> Result<Self, String> {
@@ -46,7 +46,7 @@ impl GltVariant {
                     v.params.prior = pick(
                         kv,
                         val,
-                        [("energy", Prior::Energy), ("importance", Prior::Importance)],
+                        [("power", Prior::Power), ("importance", Prior::Importance)],
                     )?
                 }
                 "below" => {
@@ -54,7 +54,7 @@ impl GltVariant {
                         kv,
                         val,
                         [
-                            ("energy", BelowCut::Energy),
+                            ("power", BelowCut::Power),
                             ("importance", BelowCut::Importance),
                         ],
                     )?

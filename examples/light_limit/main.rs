@@ -92,8 +92,8 @@ struct Args {
     #[arg(long, default_value_t = 64)]
     bsdf_samples: usize,
     /// GLT variants besides the defaults: space-separated `key=value`
-    /// settings (sigma, alpha, below=energy|importance,
-    /// modulation=none|importance, prior=energy|importance,
+    /// settings (sigma, alpha, below=power|importance,
+    /// modulation=none|importance, prior=power|importance,
     /// splat=radiance|contribution, filter=nearest|jitter, rules=paper,
     /// min-splats, threshold, train-spp); repeat the flag for several.
     #[arg(long)]

@@ -43,7 +43,7 @@ pub struct Args {
     /// The GLT's split threshold sigma.
     #[arg(long, default_value_t = 0.01)]
     pub sigma: f64,
-    /// How the GLT chooses below its cut: `energy` (the paper) or
+    /// How the GLT chooses below its cut: `power` (the paper) or
     /// `importance` (Estevez-Kulla importance of the light tree's nodes;
     /// the crate's default).
     #[arg(long, default_value = "importance", value_parser = parse_below_cut)]
@@ -70,11 +70,11 @@ pub struct Args {
     /// shading point's own cell.
     #[arg(long)]
     pub glt_jitter: bool,
-    /// The GLT's defensive prior: `energy` (the paper's power sampling) or
+    /// The GLT's defensive prior: `power` (the paper's power sampling) or
     /// `importance` (the crate's default).
     #[arg(long, default_value = "importance", value_parser = parse_prior)]
     pub prior: Prior,
-    /// Run `pt-glt` and `ppg-glt` exactly as the paper describes: energy
+    /// Run `pt-glt` and `ppg-glt` exactly as the paper describes: power
     /// below the cut, one distribution per cell, no defensive mixture
     /// (alpha 0), rebuild from any data (min-splats 0), jittered light
     /// splats. Overrides `--below-cut`, `--modulation`, `--prior`,
@@ -133,17 +133,17 @@ pub fn parse_modulation(s: &str) -> Result<Modulation, String> {
 /// Parses `--prior`.
 pub fn parse_prior(s: &str) -> Result<Prior, String> {
     match s {
-        "energy" => Ok(Prior::Energy),
+        "power" => Ok(Prior::Power),
         "importance" => Ok(Prior::Importance),
-        _ => Err(format!("`{s}`: expected `energy` or `importance`")),
+        _ => Err(format!("`{s}`: expected `power` or `importance`")),
     }
 }
 
 /// Parses `--below-cut`.
 fn parse_below_cut(s: &str) -> Result<BelowCut, String> {
     match s {
-        "energy" => Ok(BelowCut::Energy),
+        "power" => Ok(BelowCut::Power),
         "importance" => Ok(BelowCut::Importance),
-        _ => Err(format!("`{s}`: expected `energy` or `importance`")),
+        _ => Err(format!("`{s}`: expected `power` or `importance`")),
     }
 }

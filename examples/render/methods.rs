@@ -100,7 +100,7 @@ pub struct GuideParams {
     pub below_cut: BelowCut,
     /// The fewest non-zero light splats a cut rebuilds from.
     pub min_splats: u32,
-    /// The weight of the GLT's defensive mixture with the energy prior.
+    /// The weight of the GLT's defensive mixture with the power prior.
     pub alpha: f64,
     /// Whether the GLT's cut probabilities vary inside a cell.
     pub modulation: Modulation,
@@ -134,8 +134,8 @@ impl Default for GuideParams {
 }
 
 impl GuideParams {
-    /// These parameters with the paper's GLT rules: energy below the cut,
-    /// one distribution per cell, the energy prior at weight 0 (no
+    /// These parameters with the paper's GLT rules: power below the cut,
+    /// one distribution per cell, the power prior at weight 0 (no
     /// defensive mixture), rebuild from any data, jittered light splats.
     pub fn paper_rules(self) -> Self {
         let cut = CutConfig::default().with_paper_rules();
@@ -233,7 +233,7 @@ pub fn new_glt<'a>(
     let config = GltConfig {
         cut: cut_config(scene, params),
         spatial_threshold: params.glt_spatial_threshold,
-        spatial_budget: None,
+        max_bytes: None,
         filter: params.glt_filter,
     };
     Some(Glt::new(&scene.light_tree, scene.bounds, config).expect("scene bounds are finite"))

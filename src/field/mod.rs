@@ -136,7 +136,7 @@ impl<H: LightHierarchy> GuidingField<H> {
     /// A field over the light hierarchy `lights` for shading points inside
     /// `scene` (the scene's geometry bounds; points outside are clamped
     /// onto the spatial tree's cube): one cell, with a uniform quadtree and
-    /// the initial (energy prior) cut. Errors for empty or non-finite
+    /// the initial (power prior) cut. Errors for empty or non-finite
     /// bounds, and for an invalid configuration
     /// ([`FieldConfig::validate`]).
     pub fn new(lights: H, scene: Aabb, config: FieldConfig) -> Result<Self, Error> {

@@ -7,18 +7,18 @@ use crate::math::Accumulation;
 /// slot stands for.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum BelowCut {
-    /// By the light tree's subtree energy, as the paper does (one read of
+    /// By the light tree's subtree power, as the paper does (one read of
     /// the [`GuidingTree`](super::GuidingTree)'s split table per level);
     /// independent of the shading point.
-    Energy,
+    Power,
     /// By the Estevez-Kulla / pbrt-v4 importance (power x orientation /
     /// distance^2) at the shading point, the paper's suggestion for future
     /// work. Where both children have zero importance the step falls back to
-    /// energy, so the cut component stays a proper distribution.
+    /// power, so the cut component stays a proper distribution.
     ///
     /// Measured in the synthetic scene described at [`CutConfig::alpha`]
     /// (`tests/glt_defaults.rs`): 1.5-2.5x lower variance than
-    /// [`BelowCut::Energy`] at equal alpha, for a costlier walk below the
+    /// [`BelowCut::Power`] at equal alpha, for a costlier walk below the
     /// cut (two importance evaluations per level). The default, with the
     /// other importance rules (see [`CutConfig::with_importance`]).
     #[default]
@@ -66,11 +66,11 @@ pub enum Modulation {
 /// a non-zero pmf whatever the cut learned.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Prior {
-    /// Tree-by-energy from the light tree's root: power sampling, the same
+    /// Tree-by-power from the light tree's root: power sampling, the same
     /// at every shading point (the paper).
-    Energy,
+    Power,
     /// Tree-by-importance from the root (the Estevez-Kulla / pbrt-v4 rule
-    /// of [`crate::ImportanceTreeSampler`], energy where both children's
+    /// of [`crate::ImportanceTreeSampler`], power where both children's
     /// importance vanishes). The importance bound is conservative, so an
     /// emitter that can reach the point keeps a non-zero pmf. With
     /// [`Modulation::Importance`] and [`BelowCut::Importance`] the walk
@@ -83,24 +83,24 @@ pub enum Prior {
 /// How a slot that is split for the first time shares its learned weight
 /// between its two new children (they have no statistics of their own yet).
 ///
-/// Either way a child whose subtree has zero energy gets nothing: its
+/// Either way a child whose subtree has zero power gets nothing: its
 /// emitters can never receive a splat, and giving it weight would only lead
 /// the cut into lights that cannot be sampled below it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum SplitPrior {
     /// Half each, as the paper and its code do. The default, measured
     /// (`tests/glt_defaults.rs`, 2 training budgets x 2 seeds): against
-    /// [`SplitPrior::Energy`] it gave 0.70-1.04x the variance with energy
+    /// [`SplitPrior::Power`] it gave 0.70-1.04x the variance with power
     /// below the cut and 0.82-1.10x with importance (at alpha = 0.2; 6 of 8
     /// runs lower), most clearly when cells have little data: a fresh split
     /// that ignores power explores dim but near clusters sooner.
     #[default]
     Half,
-    /// In the ratio of the children's subtree energies: a freshly split
+    /// In the ratio of the children's subtree powers: a freshly split
     /// cluster is sampled exactly as it was before the split (below the cut
-    /// it was descended by energy too), so a split alone never changes the
+    /// it was descended by power too), so a split alone never changes the
     /// distribution before the cluster has data.
-    Energy,
+    Power,
 }
 
 /// The parameters of one guiding cut: how it is refined and sampled.
@@ -113,7 +113,7 @@ pub struct CutConfig {
     /// above `sigma` is split (down to single emitters); slots at or below
     /// end the cut. Default 0.01, the paper's recommendation.
     pub sigma: f64,
-    /// Weight of the defensive mixture with the energy prior:
+    /// Weight of the defensive mixture with the power prior:
     /// `pmf = (1 - alpha) * learned + alpha * prior`. Every emitter with
     /// non-zero power keeps a pmf of at least `alpha` times its prior pmf,
     /// so delta lights stay unbiased without MIS and the variance is never
@@ -122,7 +122,7 @@ pub struct CutConfig {
     /// distribution loses at most a factor `1 / (1 - alpha)` in variance.
     ///
     /// Default 0.2, measured (`tests/glt_defaults.rs`: 2000 lights in rooms,
-    /// exact variance over 300 points; energy below the cut, half splits):
+    /// exact variance over 300 points; power below the cut, half splits):
     /// the relative variance at alpha = 0.05 / 0.1 / 0.2 / 0.3 / 0.5 was
     /// 25 / 14-16 / 9.4-11 / 11 / 10.5-11 with little training and
     /// 7.7-7.9 / 4.6-5.1 / 3.9-4.3 / 3.6 / 4.1-4.3 with ten times more
@@ -199,15 +199,15 @@ impl CutConfig {
     }
 
     /// This configuration with the paper's rules: [`Modulation::None`],
-    /// [`BelowCut::Energy`] and [`Prior::Energy`]. One learned distribution
-    /// per cell, continued below the cut by subtree energy, independent of
+    /// [`BelowCut::Power`] and [`Prior::Power`]. One learned distribution
+    /// per cell, continued below the cut by subtree power, independent of
     /// the shading point: the cheapest walk (one table read per level) and
     /// the configuration to compare against the paper with.
     pub fn with_paper_rules(self) -> Self {
         Self {
             modulation: Modulation::None,
-            below_cut: BelowCut::Energy,
-            prior: Prior::Energy,
+            below_cut: BelowCut::Power,
+            prior: Prior::Power,
             ..self
         }
     }

@@ -123,11 +123,11 @@ impl GuidingCut {
     pub(crate) fn new<H: LightHierarchy + ?Sized>(tree: &H, config: &CutConfig) -> Self {
         // Modulated, a cut that has learned nothing has equal factors on
         // both sides, so it samples by the importance at the shading point
-        // (a dark side still gets nothing); else by the energy prior.
+        // (a dark side still gets nothing); else by the power prior.
         let modulated = config.modulation == super::Modulation::Importance;
         let nodes = match tree.root().and_then(|r| tree.children(r)) {
             Some([l, r]) => {
-                let (el, er) = (tree.energy(l) as f64, tree.energy(r) as f64);
+                let (el, er) = (tree.power(l) as f64, tree.power(r) as f64);
                 let (el, er) = if modulated && el > 0.0 && er > 0.0 {
                     (1.0, 1.0)
                 } else {

@@ -1,4 +1,4 @@
-//! [`GuidingTree`]: what every cell's cut shares: the light tree, its energy
+//! [`GuidingTree`]: what every cell's cut shares: the light tree, its power
 //! prior precomputed per inner node, and the configuration.
 
 use super::config::CutConfig;
@@ -11,21 +11,21 @@ use crate::math::Descent;
 use alloc::vec::Vec;
 
 /// The global light tree prepared for guiding: the hierarchy, each inner
-/// node's energy split precomputed (4 bytes per node), the tree re-laid
+/// node's power split precomputed (4 bytes per node), the tree re-laid
 /// out for sampling walks (8 bytes per node, see `src/glt/walk.rs`) and the
 /// cut configuration. One per scene; every cell's [`GuidingCut`] is sampled
 /// ([`GuidingTree::sample`]), splatted ([`GuidingTree::splat`]) and refined
 /// ([`GuidingTree::refine`]) through it.
 ///
 /// The split table is why the GLT's walk is cheaper per level than a plain
-/// energy descent: the prior probabilities of a node's children come from
+/// power descent: the prior probabilities of a node's children come from
 /// one 4-byte load instead of two 32-byte node loads (the right child lies
 /// far from its parent in memory) and a division. Each entry stores the
 /// probability of the *smaller* side in `f32`, its sign telling which side
 /// that is, so both sides keep 24 bits of relative precision: a child with
-/// 1e-9 of its parent's energy keeps its 1e-9 (a plain `f32` `p_left` would
+/// 1e-9 of its parent's power keeps its 1e-9 (a plain `f32` `p_left` would
 /// round the pair to 1 and 0 and lose the child's prior floor). A child with
-/// any positive energy gets a positive probability (at least the smallest
+/// any positive power gets a positive probability (at least the smallest
 /// `f32`); both children dark is NaN (neither can be chosen).
 #[derive(Clone, Debug)]
 pub struct GuidingTree<H: LightHierarchy> {
@@ -36,10 +36,10 @@ pub struct GuidingTree<H: LightHierarchy> {
     /// the configuration uses one.
     importance: Option<ImportanceTable>,
     config: CutConfig,
-    has_energy: bool,
+    has_power: bool,
 }
 
-/// Encodes the split of a node with child energies `el`, `er`.
+/// Encodes the split of a node with child powers `el`, `er`.
 fn encode_split(el: f32, er: f32) -> f32 {
     let (l, r) = (el as f64, er as f64);
     let Some((pl, pr)) = Descent::probabilities(l, r) else {
@@ -83,7 +83,7 @@ impl<H: LightHierarchy> GuidingTree<H> {
         let lights = &tree;
         let split: Vec<f32> = (0..lights.node_count() as u32)
             .map(|n| match lights.children(n) {
-                Some([l, r]) => encode_split(lights.energy(l), lights.energy(r)),
+                Some([l, r]) => encode_split(lights.power(l), lights.power(r)),
                 None => f32::NAN,
             })
             .collect();
@@ -93,14 +93,14 @@ impl<H: LightHierarchy> GuidingTree<H> {
         let importance = config
             .uses_importance()
             .then(|| ImportanceTable::new(lights, WalkTable::pair_nodes(lights).into_iter()));
-        let has_energy = lights.root().is_some_and(|r| lights.energy(r) > 0.0);
+        let has_power = lights.root().is_some_and(|r| lights.power(r) > 0.0);
         Ok(Self {
             tree,
             split,
             walk,
             importance,
             config,
-            has_energy,
+            has_power,
         })
     }
 
@@ -118,8 +118,8 @@ impl<H: LightHierarchy> GuidingTree<H> {
 
     /// True when some emitter has positive power.
     #[inline]
-    pub fn has_energy(&self) -> bool {
-        self.has_energy
+    pub fn has_power(&self) -> bool {
+        self.has_power
     }
 
     /// Heap bytes of the split table and the walk table (12 per
@@ -150,7 +150,7 @@ impl<H: LightHierarchy> GuidingTree<H> {
         self.importance.as_ref()
     }
 
-    /// The prior (energy) probabilities of the children of inner node
+    /// The prior (power) probabilities of the children of inner node
     /// `node`: the light tree's `E(l) / (E(l) + E(r))` and its complement,
     /// to `f32` relative precision on each side. `None` when both children
     /// are dark or `node` is not an inner node.
@@ -159,10 +159,10 @@ impl<H: LightHierarchy> GuidingTree<H> {
         decode_split(*self.split.get(node as usize)?)
     }
 
-    /// The initial cut of a cell: the light tree's root split by energy,
+    /// The initial cut of a cell: the light tree's root split by power,
     /// `p_left = E(left) / (E(left) + E(right))` (the paper's code starts at
     /// 0.5/0.5 whatever the power), so sampling it is exactly
-    /// tree-by-energy sampling (below the cut as [`BelowCut`](super::BelowCut)
+    /// tree-by-power sampling (below the cut as [`BelowCut`](super::BelowCut)
     /// says). With [`Modulation::Importance`](super::Modulation::Importance) both sides start with equal factors, so
     /// the cut samples by the importance at the shading point. A tree whose root is a leaf (or that is
     /// empty) gets the empty cut. The environment fraction starts at its

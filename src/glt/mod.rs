@@ -4,14 +4,14 @@
 //!
 //! Where to find what:
 //! - [`GuidingTree`] (`guiding_tree.rs`): what all cells share, the light
-//!   tree with its energy prior precomputed and the [`CutConfig`]; every
+//!   tree with its power prior precomputed and the [`CutConfig`]; every
 //!   operation on a cut goes through it;
 //! - [`GuidingCut`] (`cut.rs`): one cell's learned state, a weighted sub-tree
 //!   of the light tree from its root down to the cut, in two copies (sampled
 //!   [`CutNode`]s, accumulating sums);
 //! - `cut_node.rs`: the 12-byte [`CutNode`] and its [`Slot`]s;
 //! - `sampling.rs`: **the GLT's sampling rule** and its pmf (cut, then the
-//!   light tree, mixed with the energy prior and the environment light);
+//!   light tree, mixed with the power prior and the environment light);
 //! - `walk.rs`: the light tree re-laid out for the sampling walk (both
 //!   children of a node in one 16-byte load);
 //! - `splat.rs`: recording direct-light estimates ([`GuidingTree::splat`]);
@@ -21,7 +21,7 @@
 //!   [`crate::LightSampler`].
 //!
 //! How it differs from the paper's code (see the crate's reference notes):
-//! the initial cut is the energy prior, not 0.5/0.5; a defensive mixture
+//! the initial cut is the power prior, not 0.5/0.5; a defensive mixture
 //! with a prior (`alpha`, default 0.2) keeps every emitter with
 //! power at a non-zero pmf, so delta lights stay unbiased without MIS;
 //! cut nodes take 12 bytes, not 20; sums accumulate in `f64` or exactly,

@@ -97,14 +97,14 @@ fn subtree_weights(nodes: &[CutNode], sums: &[f64]) -> Vec<f64> {
     w
 }
 
-/// A fresh split's child weights. A dark child (zero energy) gets nothing.
+/// A fresh split's child weights. A dark child (zero power) gets nothing.
 fn split_weight<H: LightHierarchy + ?Sized>(
     tree: &H,
     [l, r]: [u32; 2],
     weight: f64,
     prior: SplitPrior,
 ) -> (f64, f64) {
-    let (el, er) = (tree.energy(l) as f64, tree.energy(r) as f64);
+    let (el, er) = (tree.power(l) as f64, tree.power(r) as f64);
     let (el, er) = (el.max(0.0), er.max(0.0));
     if !(el > 0.0 || er > 0.0) {
         return (0.0, 0.0);
@@ -115,7 +115,7 @@ fn split_weight<H: LightHierarchy + ?Sized>(
             (true, false) => (weight, 0.0),
             _ => (0.0, weight),
         },
-        SplitPrior::Energy => {
+        SplitPrior::Power => {
             let t = el + er;
             (weight * (el / t), weight * (er / t))
         }
@@ -136,7 +136,7 @@ fn anchor_importances(
 }
 
 /// A fresh split's child weights in proportion to the (floored)
-/// importances at the anchor; a dark child (zero energy) gets nothing.
+/// importances at the anchor; a dark child (zero power) gets nothing.
 /// `None` when no child can take the weight.
 fn split_by_importance<H: LightHierarchy + ?Sized>(
     tree: &H,
@@ -144,7 +144,7 @@ fn split_by_importance<H: LightHierarchy + ?Sized>(
     weight: f64,
     (il, ir): (f64, f64),
 ) -> Option<(f64, f64)> {
-    let lit = |n: u32, i: f64| if tree.energy(n) > 0.0 { i } else { 0.0 };
+    let lit = |n: u32, i: f64| if tree.power(n) > 0.0 { i } else { 0.0 };
     let (il, ir) = (lit(l, il), lit(r, ir));
     let t = il + ir;
     (t > 0.0 && t.is_finite()).then(|| (weight * il / t, weight * ir / t))

@@ -9,10 +9,10 @@
 //!
 //! where `f` is the cell's learned environment fraction, `q` the user's
 //! prior probability of the environment (both 0 without one), `P_prior` the
-//! prior's pmf from the light tree's root (tree-by-energy, or
+//! prior's pmf from the light tree's root (tree-by-power, or
 //! tree-by-importance at the shading point with [`Prior::Importance`]), and
 //! `P_cut` the product of the cut's probabilities down to the slot that ends
-//! the cut, then of the light tree's energy ratios (the paper) or importance
+//! the cut, then of the light tree's power ratios (the paper) or importance
 //! ratios ([`BelowCut::Importance`]) below it. Inside the cut a node's
 //! probabilities are its learned `p_left` (the paper: one distribution per
 //! cell) or, with [`Modulation::Importance`], its learned factor ratio `r`
@@ -53,7 +53,7 @@ pub(crate) struct Mixture {
 
 impl Mixture {
     /// The mixture for `cut` under a validated `config`. Emitters get
-    /// nothing when the light tree has no energy at all (then the
+    /// nothing when the light tree has no power at all (then the
     /// environment, if any, gets everything).
     #[inline]
     pub(crate) fn new(emitters: bool, cut: &GuidingCut, config: &CutConfig) -> Self {
@@ -108,7 +108,7 @@ struct Step {
     /// Learned component: the cut's `p_left` inside the cut, the below-cut
     /// rule under it. `None` where neither side can be chosen.
     cut: Option<(f64, f64)>,
-    /// Prior component: energy ratios (`None` when not tracked or both
+    /// Prior component: power ratios (`None` when not tracked or both
     /// children are dark).
     prior: Option<(f64, f64)>,
     /// The cut node on each side, `None` where the cut ends.
@@ -163,7 +163,7 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
         ctx: &'b ShadingContext,
     ) -> Self {
         let config = guide.config();
-        let mixture = Mixture::new(guide.has_energy(), cut, config);
+        let mixture = Mixture::new(guide.has_power(), cut, config);
         let modulate = config.modulation == Modulation::Importance && cut.modulated;
         let prior_importance = config.prior == Prior::Importance;
         Self {
@@ -216,14 +216,14 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
     ///   `p_left`, or with [`Modulation::Importance`] the learned factor
     ///   ratio times the children's importance at the shading point (the
     ///   learned `p_left` where both importances vanish).
-    /// - Below the cut it takes the [`BelowCut`] rule (energy where both
+    /// - Below the cut it takes the [`BelowCut`] rule (power where both
     ///   importances vanish, so the component stays a distribution).
     /// - The prior component takes the [`Prior`] rule (likewise).
     ///
     /// The children's importances are evaluated at most once per node.
     #[inline(always)]
     fn step(&self, at: Cursor, split: f32) -> Step {
-        let energy = decode_split(split);
+        let power = decode_split(split);
         let needs_importance = self.prior_importance
             || match at.cut {
                 Some(_) => self.modulate,
@@ -236,11 +236,11 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
         };
         let by_importance = || {
             imp.and_then(|(l, r)| Descent::probabilities(l, r))
-                .or(energy)
+                .or(power)
         };
         let prior = match (self.prior, self.prior_importance) {
             (false, _) => None,
-            (true, false) => energy,
+            (true, false) => power,
             (true, true) => by_importance(),
         };
         match at.cut {
@@ -260,7 +260,7 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
             }
             None => Step {
                 cut: match self.below {
-                    BelowCut::Energy => energy,
+                    BelowCut::Power => power,
                     BelowCut::Importance => by_importance(),
                 },
                 prior,
@@ -483,6 +483,6 @@ impl<H: LightHierarchy> GuidingTree<H> {
     /// True when nothing can ever be sampled: no emitter has power and
     /// there is no environment light with a positive probability.
     pub fn is_empty(&self) -> bool {
-        !self.has_energy() && self.config().environment.is_none_or(|q| q <= 0.0)
+        !self.has_power() && self.config().environment.is_none_or(|q| q <= 0.0)
     }
 }

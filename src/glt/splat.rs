@@ -32,8 +32,8 @@ impl GuidingCut {
         emitter: u32,
     ) -> Option<usize> {
         let path = tree.path(emitter)?;
-        let energy = tree.energy(path.leaf());
-        if energy.is_nan() || energy <= 0.0 {
+        let power = tree.power(path.leaf());
+        if power.is_nan() || power <= 0.0 {
             return None;
         }
         if self.nodes.is_empty() {

@@ -32,7 +32,7 @@ pub struct GltConfig {
     pub spatial_threshold: f64,
     /// Cap, in bytes, on spatial tree plus cuts when splitting cells (the
     /// cuts are charged at their size before the split); `None` for none.
-    pub spatial_budget: Option<usize>,
+    pub max_bytes: Option<usize>,
     /// The spatial filter of [`Glt::splat`]. Default
     /// [`SpatialFilter::Nearest`]: the estimate goes to the cell holding
     /// the shading point. A jittering filter carries a splat into the
@@ -58,7 +58,7 @@ impl Default for GltConfig {
         Self {
             cut: CutConfig::default(),
             spatial_threshold: 12000.0,
-            spatial_budget: None,
+            max_bytes: None,
             filter: SpatialFilter::Nearest,
         }
     }
@@ -299,7 +299,7 @@ impl<H: LightHierarchy> Glt<H> {
             |cell| cell.split_count as f64,
             |cell| cell.split_count /= 2,
             |cell| cell.cut.heap_bytes(),
-            self.config.spatial_budget,
+            self.config.max_bytes,
         );
         for cell in self.spatial.data_slice_mut() {
             self.guide.refine(&mut cell.cut);

@@ -1,7 +1,7 @@
 //! The walk table: the light tree re-laid out for the GLT's descent.
 //!
 //! Sampling a cut walks the light tree from its root to a leaf, and below
-//! the cut it needs nothing of a node but its energy split and where its
+//! the cut it needs nothing of a node but its power split and where its
 //! children are. Reading those from the light tree's 32-byte nodes costs
 //! two cache lines per level (a right child lies far from its parent) plus
 //! the split table's; profiles of the `render` example put the walk at 30%

@@ -67,8 +67,8 @@ impl Query {
     }
 
     /// [`importance`] before rounding to `f32`: finite for finite inputs
-    /// with `energy <= f32::MAX`, never NaN or negative (may be infinite
-    /// only for an infinite energy).
+    /// with `power <= f32::MAX`, never NaN or negative (may be infinite
+    /// only for an infinite power).
     #[inline]
     pub(crate) fn importance(&self, node: &NodeBounds) -> f64 {
         importance_f64(self, node)
@@ -76,7 +76,7 @@ impl Query {
 }
 
 fn importance_f64(q: &Query, node: &NodeBounds) -> f64 {
-    let phi = node.energy as f64;
+    let phi = node.power as f64;
     let b = &node.bounds;
     let valid = phi > 0.0 && q.finite && b.min.is_finite() && b.max.is_finite();
     if !valid || b.is_empty() {
@@ -216,17 +216,17 @@ mod tests {
     use super::*;
     use crate::math::{Aabb, LightCone};
 
-    fn node(bounds: Aabb, cone: LightCone, energy: f32) -> NodeBounds {
+    fn node(bounds: Aabb, cone: LightCone, power: f32) -> NodeBounds {
         NodeBounds {
             bounds,
             cone,
             two_sided: false,
-            energy,
+            power,
         }
     }
 
-    fn point(p: Vec3, energy: f32) -> NodeBounds {
-        node(Aabb::from_point(p), LightCone::SPHERE, energy)
+    fn point(p: Vec3, power: f32) -> NodeBounds {
+        node(Aabb::from_point(p), LightCone::SPHERE, power)
     }
 
     #[test]

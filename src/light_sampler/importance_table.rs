@@ -49,7 +49,7 @@ struct Entry {
     one_minus_cos_e: u16,
     /// Total power; 0 for a node that cannot contribute (no power, empty
     /// or non-finite box) or that does not exist.
-    energy: f32,
+    power: f32,
 }
 
 const _: () = assert!(core::mem::size_of::<Entry>() == 32);
@@ -85,8 +85,8 @@ fn decode(q: i16) -> f32 {
 impl Entry {
     fn new(b: &NodeBounds) -> Self {
         let (lo, hi) = (b.bounds.min, b.bounds.max);
-        let valid = b.energy > 0.0
-            && b.energy.is_finite()
+        let valid = b.power > 0.0
+            && b.power.is_finite()
             && lo.is_finite()
             && hi.is_finite()
             && !b.bounds.is_empty();
@@ -115,7 +115,7 @@ impl Entry {
             flags,
             one_minus_cos_o,
             one_minus_cos_e: bf16_up(1.0 - b.cone.cos_theta_e.clamp(-1.0, 1.0)),
-            energy: b.energy,
+            power: b.power,
         }
     }
 }
@@ -222,13 +222,13 @@ impl ImportanceTable {
 /// `f32` up to the final quotient. Finite, never negative.
 #[inline(always)]
 fn importance(q: &FastQuery, e: &Entry) -> f64 {
-    if !(e.energy > 0.0 && q.finite) {
+    if !(e.power > 0.0 && q.finite) {
         return 0.0;
     }
     let to_p = q.p - Vec3::from_array(e.center);
     let dist2 = to_p.length_squared();
     let r2 = e.radius2;
-    let phi = f64::from(e.energy);
+    let phi = f64::from(e.power);
     if dist2 <= r2 {
         // Inside the bounding sphere every direction is possible.
         return phi / f64::from(r2).max(1e-200);
@@ -328,7 +328,7 @@ mod tests {
                     // The importance without its two cosines.
                     let r2 = (0.5 * (b.bounds.max - b.bounds.min)).length_squared();
                     let d2 = (p - b.bounds.center()).length_squared().max(r2);
-                    let scale = f64::from(b.energy / d2);
+                    let scale = f64::from(b.power / d2);
                     if e > 0.0 {
                         assert!(fast >= 0.998 * e, "node {node}: exact {e}, table {fast}");
                         let slack = 1.02 * e + 5e-3 * scale;

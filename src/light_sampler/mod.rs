@@ -10,7 +10,7 @@
 //! | --- | --- |
 //! | [`UniformSampler`] | every emitter equally |
 //! | [`PowerSampler`] | proportional to power (alias table, O(1)) |
-//! | [`EnergyTreeSampler`] | descend a light tree by subtree energy |
+//! | [`PowerTreeSampler`] | descend a light tree by subtree power |
 //! | [`ImportanceTreeSampler`] | descend by power x orientation / distance^2 (Estevez & Kulla, pbrt-v4) |
 //! | [`WithEnvironment`] | any of the above plus an environment light with a fixed probability |
 //! | [`crate::glt`] | the Guiding Light Tree: learned cuts, then the light tree |
@@ -19,8 +19,8 @@ mod environment;
 mod importance;
 mod importance_table;
 mod power;
-mod tree_energy;
 mod tree_importance;
+mod tree_power;
 mod tree_walk;
 mod uniform;
 
@@ -28,8 +28,8 @@ pub use environment::WithEnvironment;
 pub use importance::importance;
 pub(crate) use importance_table::{FastQuery, ImportanceTable};
 pub use power::PowerSampler;
-pub use tree_energy::EnergyTreeSampler;
 pub use tree_importance::ImportanceTreeSampler;
+pub use tree_power::PowerTreeSampler;
 pub use uniform::UniformSampler;
 
 use crate::emitter::ShadingContext;

@@ -14,8 +14,8 @@ use crate::math::Descent;
 /// when the context has a normal.
 ///
 /// When both children of a node have zero importance (every light below is
-/// behind the point, say), that node falls back to the children's energies,
-/// so the pmf sums to 1 at every point whenever the tree has energy; a
+/// behind the point, say), that node falls back to the children's powers,
+/// so the pmf sums to 1 at every point whenever the tree has power; a
 /// one-emitter tree gives that emitter pmf 1. A child with zero importance
 /// next to one with positive importance is never chosen: it provably cannot
 /// light the point.
@@ -41,7 +41,7 @@ impl<H: LightHierarchy> ImportanceTreeSampler<H> {
     }
 
     /// The descent weights of children `l` and `r` at `ctx`: their
-    /// importances, or their energies when those are both zero (or
+    /// importances, or their powers when those are both zero (or
     /// unusable).
     #[inline]
     fn weights(&self, ctx: &ShadingContext) -> impl Fn(u32, u32) -> (f64, f64) + '_ {
@@ -52,7 +52,7 @@ impl<H: LightHierarchy> ImportanceTreeSampler<H> {
             if Descent::probabilities(il, ir).is_some() {
                 (il, ir)
             } else {
-                (self.tree.energy(l) as f64, self.tree.energy(r) as f64)
+                (self.tree.power(l) as f64, self.tree.power(r) as f64)
             }
         }
     }

@@ -1,6 +1,6 @@
 //! The `LightSampler` skeleton of the tree samplers: one exact descent
 //! from the root to sample, the same weights replayed along the emitter's
-//! path for the pmf. [`super::EnergyTreeSampler`] and
+//! path for the pmf. [`super::PowerTreeSampler`] and
 //! [`super::ImportanceTreeSampler`] differ only in the weights they pass.
 
 use super::{LightId, LightSample, pmf_to_f32};
@@ -8,11 +8,11 @@ use crate::light_tree::LightHierarchy;
 use crate::light_tree::descend::{descend, follow};
 use crate::math::Descent;
 
-/// The root of `tree`, when it has positive energy.
+/// The root of `tree`, when it has positive power.
 #[inline]
 pub(super) fn live_root<H: LightHierarchy + ?Sized>(tree: &H) -> Option<u32> {
     let root = tree.root()?;
-    (tree.energy(root) > 0.0).then_some(root)
+    (tree.power(root) > 0.0).then_some(root)
 }
 
 /// Samples an emitter of `tree` by descending from its live root with

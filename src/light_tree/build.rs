@@ -55,7 +55,7 @@ struct Aggregate {
     bounds: Aabb,
     cone: ConeBound,
     two_sided: bool,
-    energy: f64,
+    power: f64,
     link: u32,
     parent: u32,
 }
@@ -198,7 +198,7 @@ pub(super) fn build<E: Emitters + ?Sized>(
                 bounds: it.bounds,
                 cone: ConeBound::of(&it.cone),
                 two_sided: it.two_sided,
-                energy: it.power as f64,
+                power: it.power as f64,
                 link: LEAF_BIT | it.emitter,
                 parent: t.parent,
             });
@@ -216,7 +216,7 @@ pub(super) fn build<E: Emitters + ?Sized>(
             bounds: Aabb::EMPTY,
             cone: ConeBound::sphere(0.0),
             two_sided: false,
-            energy: 0.0,
+            power: 0.0,
             link: 0,
             parent: t.parent,
         });
@@ -243,9 +243,9 @@ pub(super) fn build<E: Emitters + ?Sized>(
         a.bounds = l.bounds.union(&r.bounds);
         a.cone = l.cone.union(&r.cone);
         a.two_sided = l.two_sided || r.two_sided;
-        a.energy = l.energy + r.energy;
+        a.power = l.power + r.power;
     }
-    if !((agg[0].energy as f32).is_finite()) {
+    if !((agg[0].power as f32).is_finite()) {
         return Err(BuildError::PowerOverflow);
     }
     let scene = agg[0].bounds;
@@ -260,7 +260,7 @@ pub(super) fn build<E: Emitters + ?Sized>(
                     theta_o: a.cone.theta_o,
                     cos_theta_e: a.cone.cos_theta_e,
                     two_sided: a.two_sided,
-                    energy: a.energy as f32,
+                    power: a.power as f32,
                     link: a.link,
                     parent: a.parent,
                 },

@@ -47,10 +47,10 @@ pub(crate) fn follow<H: LightHierarchy + ?Sized>(
     true
 }
 
-/// Subtree energies as descent weights.
+/// Subtree powers as descent weights.
 #[inline]
-pub(crate) fn energy_weights<H: LightHierarchy + ?Sized>(
+pub(crate) fn power_weights<H: LightHierarchy + ?Sized>(
     tree: &H,
 ) -> impl Fn(u32, u32) -> (f64, f64) {
-    move |l, r| (tree.energy(l) as f64, tree.energy(r) as f64)
+    move |l, r| (tree.power(l) as f64, tree.power(r) as f64)
 }

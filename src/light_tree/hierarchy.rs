@@ -12,7 +12,7 @@ pub struct NodeBounds {
     /// Whether any emitter below is two-sided.
     pub two_sided: bool,
     /// Total power below.
-    pub energy: f32,
+    pub power: f32,
 }
 
 /// A binary light hierarchy with one emitter per leaf.
@@ -30,8 +30,8 @@ pub trait LightHierarchy {
     /// The parent of `node`; `None` for the root.
     fn parent(&self, node: u32) -> Option<u32>;
 
-    /// Total power (energy) of the emitters below `node`.
-    fn energy(&self, node: u32) -> f32;
+    /// Total power (flux) of the emitters below `node`.
+    fn power(&self, node: u32) -> f32;
 
     /// Spatial and directional bounds of the emitters below `node`.
     fn node_bounds(&self, node: u32) -> NodeBounds;
@@ -89,8 +89,8 @@ macro_rules! forward_hierarchy {
                 (**self).parent(node)
             }
             #[inline(always)]
-            fn energy(&self, node: u32) -> f32 {
-                (**self).energy(node)
+            fn power(&self, node: u32) -> f32 {
+                (**self).power(node)
             }
             #[inline(always)]
             fn node_bounds(&self, node: u32) -> NodeBounds {

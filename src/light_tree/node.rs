@@ -40,7 +40,7 @@ pub struct LightNode {
     /// Octahedral encoding of the cone axis, 2 x 16 bits.
     axis: u32,
     /// Total power below, as `f32` bits (kept as bits so the node is `Eq`).
-    energy: u32,
+    power: u32,
     /// Right child of an inner node, or `LEAF_BIT | emitter` for a leaf.
     link: u32,
     /// Parent index, `u32::MAX` at the root.
@@ -63,7 +63,7 @@ pub(crate) struct NodeData {
     /// Whether any emitter below is two-sided.
     pub two_sided: bool,
     /// Total power below.
-    pub energy: f32,
+    pub power: f32,
     /// Right child, or `LEAF_BIT | emitter`.
     pub link: u32,
     /// Parent, or `NO_PARENT`.
@@ -79,7 +79,7 @@ impl LightNode {
             cos_theta_o,
             cos_theta_e: encode_cos_e(d.cos_theta_e) | if d.two_sided { TWO_SIDED_BIT } else { 0 },
             axis,
-            energy: d.energy.to_bits(),
+            power: d.power.to_bits(),
             link: d.link,
             parent: d.parent,
         }
@@ -87,8 +87,8 @@ impl LightNode {
 
     /// Total power below the node.
     #[inline]
-    pub fn energy(&self) -> f32 {
-        f32::from_bits(self.energy)
+    pub fn power(&self) -> f32 {
+        f32::from_bits(self.power)
     }
 
     /// True for a leaf.
@@ -130,7 +130,7 @@ impl LightNode {
                 cos_theta_e: decode_cos_e(self.cos_theta_e & !TWO_SIDED_BIT),
             },
             two_sided: self.cos_theta_e & TWO_SIDED_BIT != 0,
-            energy: self.energy(),
+            power: self.power(),
         }
     }
 }
@@ -257,14 +257,14 @@ fn sign_not_zero(p: Vec2) -> Vec2 {
 mod tests {
     use super::*;
 
-    fn data(bounds: Aabb, cone: &LightCone, two_sided: bool, energy: f32) -> NodeData {
+    fn data(bounds: Aabb, cone: &LightCone, two_sided: bool, power: f32) -> NodeData {
         NodeData {
             bounds,
             axis: cone.axis,
             theta_o: if cone.is_sphere() { PI } else { cone.theta_o() },
             cos_theta_e: cone.cos_theta_e,
             two_sided,
-            energy,
+            power,
             link: 0,
             parent: 0,
         }
@@ -341,7 +341,7 @@ mod tests {
                 need <= libm::acos(d.cone.cos_theta_o as f64),
                 "{cone:?} -> {d:?}"
             );
-            assert_eq!(d.energy, 2.0);
+            assert_eq!(d.power, 2.0);
         }
     }
 

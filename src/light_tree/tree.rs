@@ -23,7 +23,7 @@ impl LightTree {
     /// Builds the tree over `emitters` with `heuristic`.
     ///
     /// An empty list gives an empty tree. Emitters with zero power are kept
-    /// (they are simply never sampled by energy). Non-finite or empty bounds,
+    /// (they are simply never sampled by power). Non-finite or empty bounds,
     /// NaN, infinite or negative power or area, and non-finite cones are
     /// typed errors naming the emitter. O(n log n).
     pub fn build<E: Emitters + ?Sized>(
@@ -49,8 +49,8 @@ impl LightTree {
     }
 
     /// Total power of all emitters.
-    pub fn total_energy(&self) -> f32 {
-        self.nodes.first().map_or(0.0, LightNode::energy)
+    pub fn total_power(&self) -> f32 {
+        self.nodes.first().map_or(0.0, LightNode::power)
     }
 
     /// Bytes of heap memory the tree holds.
@@ -84,8 +84,8 @@ impl LightHierarchy for LightTree {
     }
 
     #[inline]
-    fn energy(&self, node: u32) -> f32 {
-        self.node(node).map_or(0.0, LightNode::energy)
+    fn power(&self, node: u32) -> f32 {
+        self.node(node).map_or(0.0, LightNode::power)
     }
 
     #[inline]
@@ -96,7 +96,7 @@ impl LightHierarchy for LightTree {
                 bounds: Aabb::EMPTY,
                 cone: crate::math::LightCone::SPHERE,
                 two_sided: false,
-                energy: 0.0,
+                power: 0.0,
             },
         }
     }

@@ -165,7 +165,7 @@ mod tests {
     }
 
     #[test]
-    fn splitting_preserves_energy_and_merging_drops_subtrees() {
+    fn splitting_preserves_power_and_merging_drops_subtrees() {
         // Root: quadrant 0 has a child node, quadrant 3 is a leaf.
         let links = [Link::new(1, 0b0001), Link::LEAF];
         let s = [

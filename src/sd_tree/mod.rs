@@ -24,7 +24,7 @@
 //! or any scalar); `pdf` is the solid-angle pdf with which `dir` was sampled
 //! (the mixture's, as PPG). With the box filter each overlapped cell gets
 //! the overlapped fraction of the box volume of both. Radiance 0 is valid:
-//! it adds weight and no energy. Invalid input is dropped, counted per
+//! it adds weight and no power. Invalid input is dropped, counted per
 //! reason ([`SdTree::dropped_splats`]) and never stored:
 //! a non-finite position, a NaN, infinite or zero-length direction, a NaN,
 //! infinite or negative radiance, a zero, negative or non-finite pdf, or

@@ -35,7 +35,7 @@ impl<T> BinaryTree<T> {
     /// before fine ones. `should_split` may be called more than once for a
     /// cell.
     ///
-    /// `budget_bytes` caps [`BinaryTree::bytes`] after the pass (memory a
+    /// `max_bytes` caps [`BinaryTree::bytes`] after the pass (memory a
     /// `T` owns on the heap is not counted; see
     /// [`BinaryTree::refine_with_heap`]). A cell whose midpoint is not
     /// representable in `f32` is never split.
@@ -43,14 +43,14 @@ impl<T> BinaryTree<T> {
         &mut self,
         should_split: impl FnMut(&T, u32) -> bool,
         split: impl FnMut(&mut T) -> T,
-        budget_bytes: Option<usize>,
+        max_bytes: Option<usize>,
     ) -> RefineOutcome {
-        self.refine_with_heap(should_split, split, |_| 0, budget_bytes)
+        self.refine_with_heap(should_split, split, |_| 0, max_bytes)
     }
 
     /// Like [`BinaryTree::refine`], counting `heap_bytes(data)` per cell
     /// towards the budget as well: the pass keeps
-    /// `bytes() + sum of heap_bytes` at or below `budget_bytes`. A split is
+    /// `bytes() + sum of heap_bytes` at or below `max_bytes`. A split is
     /// charged two nodes, one cell's bookkeeping and `T`, and the heap bytes
     /// of the cell before the split (the copy is assumed as large as the
     /// original); after the split the upper child's real size is charged.
@@ -59,11 +59,11 @@ impl<T> BinaryTree<T> {
         mut should_split: impl FnMut(&T, u32) -> bool,
         mut split: impl FnMut(&mut T) -> T,
         mut heap_bytes: impl FnMut(&T) -> usize,
-        budget_bytes: Option<usize>,
+        max_bytes: Option<usize>,
     ) -> RefineOutcome {
         let mut outcome = RefineOutcome::default();
         let fixed = 2 * Self::NODE_BYTES + Self::CELL_META_BYTES + core::mem::size_of::<T>();
-        let mut used = match budget_bytes {
+        let mut used = match max_bytes {
             Some(_) => self.bytes() + self.cells.iter().map(&mut heap_bytes).sum::<usize>(),
             None => 0,
         };
@@ -81,7 +81,7 @@ impl<T> BinaryTree<T> {
                 outcome.refused_by_precision += 1;
                 continue;
             }
-            if let Some(budget) = budget_bytes {
+            if let Some(budget) = max_bytes {
                 let cost = fixed + heap_bytes(&self.cells[ci]);
                 if used.saturating_add(cost) > budget {
                     outcome.refused_by_budget += 1;
@@ -89,7 +89,7 @@ impl<T> BinaryTree<T> {
                 }
             }
             let upper_data = split(&mut self.cells[ci]);
-            if budget_bytes.is_some() {
+            if max_bytes.is_some() {
                 used += fixed + heap_bytes(&upper_data);
             }
             let first = self.nodes.len() as u32;

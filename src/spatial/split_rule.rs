@@ -31,7 +31,7 @@ impl<T: Clone> BinaryTree<T> {
     /// statistical weight it collected) is above `threshold`; the cell is
     /// first given `halve`, then both children hold a copy of it (the upper
     /// one a clone), and both are asked again, so one pass can split a cell
-    /// several levels deep. `heap_bytes` and `budget_bytes` are those of
+    /// several levels deep. `heap_bytes` and `max_bytes` are those of
     /// [`BinaryTree::refine_with_heap`].
     pub fn split_by_weight(
         &mut self,
@@ -39,7 +39,7 @@ impl<T: Clone> BinaryTree<T> {
         mut weight: impl FnMut(&T) -> f64,
         mut halve: impl FnMut(&mut T),
         heap_bytes: impl FnMut(&T) -> usize,
-        budget_bytes: Option<usize>,
+        max_bytes: Option<usize>,
     ) -> RefineOutcome {
         self.refine_with_heap(
             |cell, _| weight(cell) > threshold,
@@ -48,7 +48,7 @@ impl<T: Clone> BinaryTree<T> {
                 cell.clone()
             },
             heap_bytes,
-            budget_bytes,
+            max_bytes,
         )
     }
 }
