@@ -4,7 +4,7 @@
 //!
 //! Each module only uses the ones above it:
 //! 1. [`math`]: boxes, cones, the sphere map, the exact one-number
-//!    [`math::Descent`], thread-safe [`math::SumBuffer`]s;
+//!    descent (`src/math/descent.rs`), thread-safe sums (`src/math/sum.rs`);
 //! 2. [`emitter`]: the [`Emitters`] trait and [`ShadingContext`];
 //! 3. [`light_tree`]: [`LightHierarchy`] and the [`LightTree`] BVH;
 //! 4. [`light_sampler`]: [`LightSampler`] and its baselines;

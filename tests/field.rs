@@ -9,7 +9,8 @@ use guiding::glt::{BelowCut, CutConfig, Glt, GltConfig, GuidingCut, GuidingTree,
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::{Aabb, Accumulation, canonical_to_dir};
 use guiding::quadtree::UNIFORM_PDF;
-use guiding::sd_tree::{SdCell, SdTree, SdTreeConfig, SpatialFilter};
+use guiding::sd_tree::{SdCell, SdTree, SdTreeConfig};
+use guiding::spatial::SpatialFilter;
 use guiding::spatial::{RefineOutcome, SpatialTree};
 use guiding::{Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext};
 use proptest::prelude::*;

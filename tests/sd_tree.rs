@@ -5,7 +5,8 @@
 use glam::{Vec2, Vec3};
 use guiding::math::{Aabb, Accumulation, canonical_to_dir};
 use guiding::quadtree::{DirectionalFilter, UNIFORM_PDF};
-use guiding::sd_tree::{SdTree, SdTreeConfig, SpatialFilter};
+use guiding::sd_tree::{SdTree, SdTreeConfig};
+use guiding::spatial::SpatialFilter;
 use guiding::spatial::SpatialTree;
 use rand_core::{Rng, SeedableRng};
 use rand_pcg::Pcg32;

@@ -16,7 +16,7 @@ use glam::Vec3;
 ///   always has a larger index than its parent), root first. An empty vector
 ///   means the cut ends at the light tree's root: the whole tree is one
 ///   cluster (a single-light scene, or `sigma >= 1`).
-/// - The *accumulating* copy is a [`SumBuffer`] with one sum per slot (sum
+/// - The *accumulating* copy is a set of thread-safe sums (`src/math/sum.rs`), one per slot (sum
 ///   `2 i + side` for slot `side` of node `i`; a single sum for the root
 ///   cluster of an empty cut) and one last sum for the environment light.
 ///

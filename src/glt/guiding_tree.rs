@@ -150,15 +150,6 @@ impl<H: LightHierarchy> GuidingTree<H> {
         self.importance.as_ref()
     }
 
-    /// The prior (power) probabilities of the children of inner node
-    /// `node`: the light tree's `E(l) / (E(l) + E(r))` and its complement,
-    /// to `f32` relative precision on each side. `None` when both children
-    /// are dark or `node` is not an inner node.
-    #[inline(always)]
-    pub fn prior_split(&self, node: u32) -> Option<(f64, f64)> {
-        decode_split(*self.split.get(node as usize)?)
-    }
-
     /// The initial cut of a cell: the light tree's root split by power,
     /// `p_left = E(left) / (E(left) + E(right))` (the paper's code starts at
     /// 0.5/0.5 whatever the power), so sampling it is exactly

@@ -12,7 +12,7 @@ use crate::light_tree::descend::power_weights;
 /// `f32` rounding of the stored subtree powers).
 ///
 /// One `u` drives the whole walk through the exact `f64` descent of
-/// [`Descent`](crate::math::Descent), so the choice is the inverse CDF of
+/// `Descent` (`src/math/descent.rs`), so the choice is the inverse CDF of
 /// the leaves in tree order at any depth. `pmf` replays the emitter's
 /// root-to-leaf path with the same arithmetic, so both agree bit for bit. A zero-power subtree is never
 /// entered; when the root has no power nothing is sampled. O(depth) per

@@ -6,7 +6,7 @@
 //! - the *sampling* copy answers [`DirectionalTree::sample`] and
 //!   [`DirectionalTree::pdf`]; it is plain data, read-only between refines;
 //! - the *building* copy collects [`DirectionalTree::splat`]s from many
-//!   threads through `&self` into a [`SumBuffer`](crate::math::SumBuffer)
+//!   threads through `&self` into thread-safe sums (`src/math/sum.rs`)
 //!   (lock-free, no lost update, no `f32` accumulation error, bit-identical in
 //!   [`Accumulation::Deterministic`](crate::math::Accumulation) mode).
 //!

@@ -57,7 +57,7 @@
 //! learning and needs no atomics or locks. The public implementation takes
 //! one Adam step per sample, serialised per cell, with the gradient at the
 //! current `s`; here the work at record time is only adding to
-//! [`SumBuffer`](crate::math::SumBuffer)s: per cell a histogram of `log(p_bsdf / p_guide)` (14 bins) holding `sum f/q` and
+//! thread-safe sums (`src/math/sum.rs`): per cell a histogram of `log(p_bsdf / p_guide)` (14 bins) holding `sum f/q` and
 //! `sum (f/q) r` with `r = p_bsdf / (p_bsdf + p_guide)`. That histogram
 //! describes the iteration's Monte Carlo estimate of the loss at *every*
 //! `s` (see `fraction.rs`), so `refine` runs up to
@@ -114,10 +114,8 @@ mod splat;
 mod state;
 mod validate;
 
-pub use crate::spatial::SpatialFilter;
 pub use cell::SdCell;
 pub use config::SdTreeConfig;
-pub use fraction::{BETA1, BETA2, LEARNING_RATE, THETA_LIMIT};
 pub use memory::SdTreeMemory;
 pub(crate) use state::SdState;
 

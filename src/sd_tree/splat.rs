@@ -2,11 +2,12 @@
 
 use super::state::SdState;
 use super::validate::splat_value;
-use super::{SdCell, SdTree, SpatialFilter};
+use super::{SdCell, SdTree};
 use crate::dropped::DropReason;
 use crate::math::Aabb;
 use crate::math::unit_direction;
 use crate::quadtree::DirectionalFilter;
+use crate::spatial::SpatialFilter;
 use crate::spatial::{BinaryTree, CellId, SpatialTree, jitter_u32x3};
 use glam::Vec3;
 use rand_core::Rng;

@@ -39,7 +39,7 @@ pub struct BinaryTree<T> {
 
 impl<T> BinaryTree<T> {
     /// A tree with one cell holding `data`, covering the cube around `scene`
-    /// (see [`root_cube`](super::root_cube)). Errors for empty or non-finite
+    /// (`src/spatial/root_cube.rs`). Errors for empty or non-finite
     /// bounds.
     pub fn new(scene: Aabb, data: T) -> Result<Self, SpatialError> {
         let root = root_cube(&scene)?;

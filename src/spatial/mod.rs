@@ -49,6 +49,6 @@ pub use cell_id::{CellId, CellIds};
 pub use filter::SpatialFilter;
 pub(crate) use filter::{jitter_u32x3, jitter_u64};
 pub use refine::RefineOutcome;
-pub use root_cube::{SpatialError, root_cube};
+pub use root_cube::SpatialError;
 pub use split_rule::split_threshold;
 pub use tree_trait::SpatialTree;
