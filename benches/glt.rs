@@ -17,7 +17,7 @@
 
 use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
 use glam::Vec3;
-use guiding::glt::{BelowCut, CutConfig, CutNode, Glt, GltConfig, GuidingCut, GuidingTree};
+use guiding::glt::{BelowCut, CutConfig, CutNode, CutRules, Glt, GltConfig, GuidingCut};
 use guiding::light_sampler::PowerTreeSampler;
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Aabb;
@@ -70,7 +70,7 @@ fn contribution(lights: &[Emitter], e: u32, p: Vec3) -> f32 {
 
 const POINT: Vec3 = Vec3::new(10.0, -20.0, 5.0);
 
-fn trained_cut(lights: &[Emitter], guide: &GuidingTree<&LightTree>) -> GuidingCut {
+fn trained_cut(lights: &[Emitter], guide: &CutRules<&LightTree>) -> GuidingCut {
     let mut rng = Rand::new(7);
     let ctx = ShadingContext::on_surface(POINT, Vec3::Y);
     let mut cut = guide.new_cut();
@@ -141,7 +141,7 @@ fn bench_sampling(c: &mut Criterion) {
         // same leaves, so the same path lengths; the ratio to `power` is
         // the rule's own overhead. Trained cuts choose other (often deeper)
         // leaves, which costs more for any sampler.
-        let fresh_guide = GuidingTree::new(&tree, CutConfig::default()).unwrap();
+        let fresh_guide = CutRules::new(&tree, CutConfig::default()).unwrap();
         let fresh = fresh_guide.new_cut();
         group.bench_function("cut-untrained/sample+pmf", |b| {
             b.iter(|| {
@@ -168,7 +168,7 @@ fn bench_sampling(c: &mut Criterion) {
                 sigma,
                 ..CutConfig::default()
             };
-            let guide = GuidingTree::new(&tree, config).unwrap();
+            let guide = CutRules::new(&tree, config).unwrap();
             let cut = trained_cut(&lights, &guide);
             let sampled: Vec<LightId> = u
                 .iter()
@@ -238,7 +238,7 @@ fn bench_sampling(c: &mut Criterion) {
                     },
                 ),
             ] {
-                let guide = GuidingTree::new(&tree, config).unwrap();
+                let guide = CutRules::new(&tree, config).unwrap();
                 let cut = trained_cut(&lights, &guide);
                 group.bench_function(name, |b| {
                     b.iter(|| {
@@ -297,7 +297,7 @@ fn bench_sampling(c: &mut Criterion) {
                 })
             });
             let config = CutConfig::default();
-            let guide = GuidingTree::new(&tree, config).unwrap();
+            let guide = CutRules::new(&tree, config).unwrap();
             let cut = trained_cut(&lights, &guide);
             group.bench_function("cut/splat", |b| {
                 b.iter(|| {
@@ -314,7 +314,7 @@ fn bench_sampling(c: &mut Criterion) {
                 sigma,
                 ..CutConfig::default()
             };
-            let guide = GuidingTree::new(&tree, config).unwrap();
+            let guide = CutRules::new(&tree, config).unwrap();
             // A trained cut holding one iteration's sums.
             let cut = trained_cut(&lights, &guide);
             let mut rng = Rand::new(5);

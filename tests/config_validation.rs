@@ -5,7 +5,7 @@ mod common;
 
 use common::{scene, two_rooms};
 use guiding::field::{FieldConfig, GuidingField};
-use guiding::glt::{CutConfig, Glt, GltConfig, GuidingTree};
+use guiding::glt::{CutConfig, CutRules, Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::quadtree::QuadtreeConfig;
 use guiding::sd_tree::{SdTree, SdTreeConfig};
@@ -19,7 +19,7 @@ fn tree() -> LightTree {
 /// `field`, or accepts it.
 fn check_cut(cut: CutConfig, field: Option<&str>) {
     let tree = tree();
-    let direct = GuidingTree::new(&tree, cut).map(|_| ());
+    let direct = CutRules::new(&tree, cut).map(|_| ());
     let glt = Glt::new(
         &tree,
         scene(),

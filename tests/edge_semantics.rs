@@ -7,7 +7,7 @@ mod common;
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
 use guiding::field::{FieldConfig, GuidingField};
-use guiding::glt::{CutConfig, Glt, GltConfig, GuidingTree};
+use guiding::glt::{CutConfig, CutRules, Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::{
     ImportanceTreeSampler, LightId, LightSampler, LightTree, PowerSampler, PowerTreeSampler,
@@ -89,7 +89,7 @@ fn every_sampler_has_the_same_edges() {
         glt.refine();
     }
     check("glt", &glt, n);
-    let guide = GuidingTree::new(&tree, CutConfig::default()).unwrap();
+    let guide = CutRules::new(&tree, CutConfig::default()).unwrap();
     let cut = guide.new_cut();
     check("cut sampler", &guide.sampler(&cut), n);
     let field = GuidingField::new(&tree, scene(), FieldConfig::default()).unwrap();

@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 use guiding::field::{FieldConfig, GuidingField};
-use guiding::glt::{BelowCut, CutConfig, Glt, GltConfig, GuidingCut, GuidingTree, SplatOutcome};
+use guiding::glt::{BelowCut, CutConfig, CutRules, Glt, GltConfig, GuidingCut, SplatOutcome};
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::{Aabb, Accumulation, canonical_to_dir};
 use guiding::quadtree::UNIFORM_PDF;
@@ -93,7 +93,7 @@ fn bounds_bits(b: Aabb) -> [u32; 6] {
 /// The field against an [`SdTree`] fed the same radiance splats and
 /// fraction records (with identically seeded generators) and, per cell of
 /// that SD-tree, a cut of its own fed the same light splats through the
-/// [`GuidingTree`] (cuts copied to both children when the SD-tree splits a
+/// [`CutRules`] (cuts copied to both children when the SD-tree splits a
 /// cell). All records and queries go through one [`FieldVertex`] lookup per
 /// point; the SD-tree and the cuts are asked by position. Everything is
 /// equal bit for bit: spatial decisions, quadtrees, fractions, cuts, pdfs,
@@ -110,7 +110,7 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
     };
     let mut field = GuidingField::new(&tree, scene(), config).unwrap();
     let mut sd = SdTree::new(scene(), sd_config).unwrap();
-    let guide = GuidingTree::new(&tree, config.cut).unwrap();
+    let guide = CutRules::new(&tree, config.cut).unwrap();
     let mut cuts = vec![guide.new_cut()];
     let mut rng = Rand::seeded(1);
     let mut learned = false;

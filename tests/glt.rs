@@ -6,7 +6,7 @@
 
 use glam::Vec3;
 use guiding::glt::{
-    BelowCut, CutConfig, CutNode, GuidingCut, GuidingTree, Modulation, Prior, Slot, SplatOutcome,
+    BelowCut, CutConfig, CutNode, CutRules, GuidingCut, Modulation, Prior, Slot, SplatOutcome,
     SplitPrior,
 };
 use guiding::light_tree::{BuildHeuristic, EmitterPath, NodeBounds};
@@ -65,7 +65,7 @@ fn assert_valid_cut<H: LightHierarchy + ?Sized>(tree: &H, cut: &GuidingCut) {
 
 /// Sum of the exact pmf over every emitter and the environment.
 fn pmf_total<H: LightHierarchy + ?Sized>(
-    guide: &GuidingTree<&H>,
+    guide: &CutRules<&H>,
     cut: &GuidingCut,
     ctx: &ShadingContext,
 ) -> f64 {
@@ -79,7 +79,7 @@ fn pmf_total<H: LightHierarchy + ?Sized>(
 }
 
 /// What the total pmf must be: 1 when anything can be sampled.
-fn expected_total<H: LightHierarchy + ?Sized>(guide: &GuidingTree<&H>) -> f64 {
+fn expected_total<H: LightHierarchy + ?Sized>(guide: &CutRules<&H>) -> f64 {
     let tree = guide.light_tree();
     let emitters = tree.root().is_some_and(|r| tree.power(r) > 0.0);
     let env = guide.config().environment.is_some();
@@ -89,7 +89,7 @@ fn expected_total<H: LightHierarchy + ?Sized>(guide: &GuidingTree<&H>) -> f64 {
 /// `sample`'s pmf equals `pmf()` bit for bit, in `f64` and in `f32`, and a
 /// sampled light always has a positive pmf.
 fn assert_sample_matches_pmf<H: LightHierarchy + ?Sized>(
-    guide: &GuidingTree<&H>,
+    guide: &CutRules<&H>,
     cut: &GuidingCut,
     ctx: &ShadingContext,
     rng: &mut Rand,
@@ -286,7 +286,7 @@ proptest! {
     ) {
         let lights: Vec<Emitter> = emitters.iter().map(build_emitter).collect();
         let tree = LightTree::build(&lights, HEURISTICS[heuristic]).unwrap();
-        let guide = GuidingTree::new(&tree, config).unwrap();
+        let guide = CutRules::new(&tree, config).unwrap();
         let n = lights.len() as u32;
         let mut rng = Rand::new(seed);
         let mut cut = guide.new_cut();
@@ -365,7 +365,7 @@ fn learns_the_visible_subset() {
                 split_prior,
                 ..CutConfig::default().with_paper_rules()
             };
-            let guide = GuidingTree::new(&tree, config).unwrap();
+            let guide = CutRules::new(&tree, config).unwrap();
             let mass = |cut: &GuidingCut| -> f64 {
                 (0..64)
                     .filter(|&e| visible(e))
@@ -420,7 +420,7 @@ fn power_split_prior_preserves_the_distribution() {
             min_splats: 0,
             ..CutConfig::default().with_paper_rules()
         };
-        let guide = GuidingTree::new(&tree, config).unwrap();
+        let guide = CutRules::new(&tree, config).unwrap();
         let mut cut = guide.new_cut();
         let before: Vec<f64> = (0..200)
             .map(|e| guide.pmf_exact(&cut, &ctx, LightId::Emitter(e)))
@@ -458,7 +458,7 @@ fn too_few_splats_defer_the_rebuild_and_keep_the_data() {
     let mut rng = Rand::new(8);
     let lights = lights_in_box(&mut rng, 300, 5.0);
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
-    let guide = GuidingTree::new(&tree, CutConfig::default()).unwrap();
+    let guide = CutRules::new(&tree, CutConfig::default()).unwrap();
     let min = guide.config().min_splats;
     assert!(min > 1);
     let mut cut = guide.new_cut();
@@ -520,7 +520,7 @@ fn splits_to_leaves_and_merges_back() {
         min_splats: 0,
         ..CutConfig::default()
     };
-    let guide = GuidingTree::new(&tree, config).unwrap();
+    let guide = CutRules::new(&tree, config).unwrap();
     let mut cut = guide.new_cut();
     // Uniform contributions: every emitter's share 1/300 < sigma, so the cut
     // stops above the leaves but grows large.
@@ -613,7 +613,7 @@ fn estimate_is_unbiased_with_the_defensive_mixture() {
             split_prior,
             ..CutConfig::default()
         };
-        let guide = GuidingTree::new(&tree, train).unwrap();
+        let guide = CutRules::new(&tree, train).unwrap();
         for (k, &p) in points.iter().enumerate() {
             let ctx = ShadingContext::on_surface(p, Vec3::Y);
             let truth: f64 = lights.iter().map(|l| contribution(l, p)).sum();
@@ -634,7 +634,7 @@ fn estimate_is_unbiased_with_the_defensive_mixture() {
                 alpha: 0.0,
                 ..train
             };
-            let blind_guide = GuidingTree::new(&tree, blind).unwrap();
+            let blind_guide = CutRules::new(&tree, blind).unwrap();
             let biased: f64 = (0..60u32)
                 .filter(|&e| blind_guide.pmf_exact(&cut, &ctx, LightId::Emitter(e)) > 0.0)
                 .map(|e| contribution(&lights[e as usize], p))
@@ -767,7 +767,7 @@ fn deep_chain_is_exact_in_distribution() {
             split_prior,
             ..CutConfig::default()
         };
-        let guide = GuidingTree::new(&chain, config).unwrap();
+        let guide = CutRules::new(&chain, config).unwrap();
         let mut cut = guide.new_cut();
         // Learned targets: large for k < 70 (skewed), small tail whose total
         // share (< sigma) ends the cut at depth 70. Fresh half splits reach
@@ -833,7 +833,7 @@ fn sums_across_sixty_decades() {
             environment: Some(0.1),
             ..CutConfig::default()
         };
-        let guide = GuidingTree::new(&tree, config).unwrap();
+        let guide = CutRules::new(&tree, config).unwrap();
         let mut cut = guide.new_cut();
         for round in 0..3 {
             for e in 0..500u32 {
@@ -882,7 +882,7 @@ fn tiny_scenes() {
                     environment,
                     ..CutConfig::default()
                 };
-                let guide = GuidingTree::new(&tree, config).unwrap();
+                let guide = CutRules::new(&tree, config).unwrap();
                 let mut cut = guide.new_cut();
                 let ctx = ShadingContext::at(Vec3::splat(0.5));
                 for round in 0..3 {
@@ -902,7 +902,7 @@ fn tiny_scenes() {
         }
         if lights.len() == 1 {
             let config = CutConfig::default();
-            let guide = GuidingTree::new(&tree, config).unwrap();
+            let guide = CutRules::new(&tree, config).unwrap();
             let cut = guide.new_cut();
             assert!(cut.nodes().is_empty());
             let s = guide.sample(&cut, &ShadingContext::at(Vec3::ZERO), 0.7);
@@ -941,7 +941,7 @@ fn zero_power_subtrees() {
             sigma: 0.0,
             ..CutConfig::default()
         };
-        let guide = GuidingTree::new(&tree, config).unwrap();
+        let guide = CutRules::new(&tree, config).unwrap();
         let mut cut = guide.new_cut();
         for _ in 0..3 {
             for e in 0..200u32 {
@@ -978,7 +978,7 @@ fn prior_floor_survives_extreme_ratios() {
         min_splats: 0,
         ..CutConfig::default().with_paper_rules()
     };
-    let guide = GuidingTree::new(&tree, config).unwrap();
+    let guide = CutRules::new(&tree, config).unwrap();
     let alpha = guide.config().alpha;
     let mut cut = guide.new_cut();
     for _ in 0..3 {
@@ -1008,7 +1008,7 @@ fn a_million_lights() {
         .collect();
     let tree = LightTree::build(&lights, BuildHeuristic::Balanced).unwrap();
     let config = CutConfig::default();
-    let guide = GuidingTree::new(&tree, config).unwrap();
+    let guide = CutRules::new(&tree, config).unwrap();
     let mut cut = guide.new_cut();
     let ctx = ShadingContext::on_surface(Vec3::new(10.0, -3.0, 5.0), Vec3::Y);
     for _ in 0..2 {
@@ -1063,7 +1063,7 @@ fn threads_equal_serial() {
             sigma: 0.002,
             ..CutConfig::default()
         };
-        let guide = GuidingTree::new(&tree, config).unwrap();
+        let guide = CutRules::new(&tree, config).unwrap();
         let mut serial = guide.new_cut();
         let mut parallel = serial.clone();
         for round in 0..3 {
@@ -1123,7 +1123,7 @@ fn cut_node_is_twelve_bytes() {
             accumulation,
             ..CutConfig::default()
         };
-        let guide = GuidingTree::new(&tree, config).unwrap();
+        let guide = CutRules::new(&tree, config).unwrap();
         let mut cut = guide.new_cut();
         for e in 0..100 {
             guide.splat(&cut, LightId::Emitter(e), 1.0 + (e % 3) as f32);
@@ -1175,7 +1175,7 @@ fn modulation_reproduces_the_learned_cut_at_the_anchor_and_follows_importance() 
         .collect();
     let tree = LightTree::build(&lights, BuildHeuristic::Sah).unwrap();
     let make = |modulation| {
-        GuidingTree::new(
+        CutRules::new(
             &tree,
             CutConfig {
                 modulation,
@@ -1232,7 +1232,7 @@ fn modulation_reproduces_the_learned_cut_at_the_anchor_and_follows_importance() 
     // Near the row's start the first lights matter far more than at the
     // anchor; the plain cut cannot know.
     let near = ShadingContext::at(Vec3::new(0.0, 0.0, 0.0));
-    let first = |g: &GuidingTree<&LightTree>, c| g.pmf_exact(c, &near, LightId::Emitter(0));
+    let first = |g: &CutRules<&LightTree>, c| g.pmf_exact(c, &near, LightId::Emitter(0));
     assert!(
         first(&modulated, &b) > 3.0 * first(&plain, &a),
         "near light: {} vs {}",
@@ -1241,7 +1241,7 @@ fn modulation_reproduces_the_learned_cut_at_the_anchor_and_follows_importance() 
     );
     // And it samples the near point's inverse-square contributions with a
     // lower second moment, sum c^2 / p.
-    let m2 = |g: &GuidingTree<&LightTree>, c| {
+    let m2 = |g: &CutRules<&LightTree>, c| {
         (0..32u32)
             .map(|i| {
                 let d2 = (lights[i as usize].bounds.center() - near.position).length_squared();

@@ -18,7 +18,7 @@ pub struct FieldMemory {
     /// The cuts together. Their `inline_bytes` are already in
     /// `sd.spatial_bytes` and are not added again in the totals.
     pub cuts: CutMemory,
-    /// The [`GuidingTree`](crate::glt::GuidingTree)'s split table, shared
+    /// The [`CutRules`](crate::glt::CutRules)'s split table, shared
     /// by all cells: split and walk tables, 12 bytes per light-tree node
     /// (plus 8).
     pub shared_bytes: usize,

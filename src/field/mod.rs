@@ -30,7 +30,7 @@
 //! records, the per-cell SD refinement, the spatial filters, the split rule
 //! and the dropped-input counting are the SD-tree's own functions run over
 //! this field's cells, and light splats, cut sampling and cut refinement
-//! are the [`GuidingTree`]'s. So, fed the same records (and random
+//! are the [`CutRules`]'s. So, fed the same records (and random
 //! numbers), the field's spatial tree and quadtrees equal those of an
 //! [`SdTree`](crate::sd_tree::SdTree) with the same configuration bit for
 //! bit, and each cell's cut equals a cut fed the light splats that landed
@@ -109,7 +109,7 @@ pub use vertex::FieldVertex;
 use crate::dropped::{DropReason, DroppedSplats};
 use crate::emitter::ShadingContext;
 use crate::error::Error;
-use crate::glt::{GuidingTree, SplatOutcome};
+use crate::glt::{CutRules, SplatOutcome};
 use crate::light_sampler::{LightId, LightSample, LightSampler};
 use crate::light_tree::LightHierarchy;
 use crate::math::Aabb;
@@ -128,7 +128,7 @@ pub struct GuidingField<H: LightHierarchy> {
     cells: BinaryTree<FieldCell>,
     /// The SD-tree's configuration, iteration count and drop counters.
     sd: SdState,
-    guide: GuidingTree<H>,
+    guide: CutRules<H>,
     light_filter: SpatialFilter,
 }
 
@@ -141,7 +141,7 @@ impl<H: LightHierarchy> GuidingField<H> {
     /// ([`FieldConfig::validate`]).
     pub fn new(lights: H, scene: Aabb, config: FieldConfig) -> Result<Self, Error> {
         config.validate()?;
-        let guide = GuidingTree::new(lights, config.cut)?;
+        let guide = CutRules::new(lights, config.cut)?;
         let sd = SdState::new(config.sd);
         let cell = FieldCell {
             sd: sd.new_cell(),
@@ -210,7 +210,7 @@ impl<H: LightHierarchy> GuidingField<H> {
     }
 
     /// The guiding tree every cell's cut is used through.
-    pub fn guiding_tree(&self) -> &GuidingTree<H> {
+    pub fn cut_rules(&self) -> &CutRules<H> {
         &self.guide
     }
 

@@ -47,7 +47,7 @@ impl<H: LightHierarchy> GuidingField<H> {
 
     /// The GLT's record, as [`Glt::splat`](crate::glt::Glt::splat): the
     /// direct-light estimate `value` for `light` seen from `p` (see
-    /// [`GuidingTree::splat`](crate::glt::GuidingTree::splat) for what it
+    /// [`CutRules::splat`](crate::glt::CutRules::splat) for what it
     /// is) into the cut of the cell(s) that
     /// [`FieldConfig::light_filter`](super::FieldConfig::light_filter)
     /// spreads `p` over (by default the cell holding `p`; the stochastic

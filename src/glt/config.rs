@@ -8,7 +8,7 @@ use crate::math::Accumulation;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum BelowCut {
     /// By the light tree's subtree power, as the paper does (one read of
-    /// the [`GuidingTree`](super::GuidingTree)'s split table per level);
+    /// the [`CutRules`](super::CutRules)'s split table per level);
     /// independent of the shading point.
     Power,
     /// By the Estevez-Kulla / pbrt-v4 importance (power x orientation /
@@ -52,9 +52,9 @@ pub enum Modulation {
     /// bound misses (visibility, the BSDF). Where both importances at `x`
     /// are zero the step falls back to `r`. Splats must carry their
     /// position for the anchor ([`crate::glt::Glt`] and the combined field
-    /// do, [`crate::glt::GuidingTree::splat_from`] does); a cut rebuilt
+    /// do, [`crate::glt::CutRules::splat_from`] does); a cut rebuilt
     /// without one (splatted only through
-    /// [`crate::glt::GuidingTree::splat`]) keeps plain learned
+    /// [`crate::glt::CutRules::splat`]) keeps plain learned
     /// probabilities. The initial cut has equal factors: it samples by the
     /// importance at the shading point until it has learned. The default.
     #[default]
@@ -153,7 +153,7 @@ pub struct CutConfig {
     /// whatever the thread count (48 bytes per sum instead of 8).
     pub accumulation: Accumulation,
     /// The fewest non-zero splats a cut rebuilds from. Below it,
-    /// [`GuidingTree::refine`](super::GuidingTree::refine) keeps the cut as
+    /// [`CutRules::refine`](super::CutRules::refine) keeps the cut as
     /// it is and lets its sums go on accumulating into the next iteration:
     /// a light splat is an unbiased estimate whatever distribution drew it,
     /// so sums from several iterations add up. Without this floor a cell

@@ -20,9 +20,9 @@ use glam::Vec3;
 ///   `2 i + side` for slot `side` of node `i`; a single sum for the root
 ///   cluster of an empty cut) and one last sum for the environment light.
 ///
-/// A cut is used through the [`GuidingTree`](super::GuidingTree) of its
-/// light tree: [`GuidingTree::new_cut`](super::GuidingTree::new_cut) makes
-/// one, [`GuidingTree::refine`](super::GuidingTree::refine) rebuilds the
+/// A cut is used through the [`CutRules`](super::CutRules) of its
+/// light tree: [`CutRules::new_cut`](super::CutRules::new_cut) makes
+/// one, [`CutRules::refine`](super::CutRules::refine) rebuilds the
 /// sampled copy from the sums and zeroes them. Sampling, pmf and splatting
 /// take `&GuidingCut`; the sums take concurrent adds without locks.
 #[derive(Clone, Debug)]
@@ -119,7 +119,7 @@ impl core::ops::AddAssign for CutMemory {
 }
 
 impl GuidingCut {
-    /// The initial cut (see [`GuidingTree::new_cut`](super::GuidingTree::new_cut)).
+    /// The initial cut (see [`CutRules::new_cut`](super::CutRules::new_cut)).
     pub(crate) fn new<H: LightHierarchy + ?Sized>(tree: &H, config: &CutConfig) -> Self {
         // Modulated, a cut that has learned nothing has equal factors on
         // both sides, so it samples by the importance at the shading point

@@ -3,7 +3,7 @@
 //! guide next-event estimation.
 //!
 //! Where to find what:
-//! - [`GuidingTree`] (`guiding_tree.rs`): what all cells share, the light
+//! - [`CutRules`] (`cut_rules.rs`): what all cells share, the light
 //!   tree with its power prior precomputed and the [`CutConfig`]; every
 //!   operation on a cut goes through it;
 //! - [`GuidingCut`] (`cut.rs`): one cell's learned state, a weighted sub-tree
@@ -14,8 +14,8 @@
 //!   light tree, mixed with the power prior and the environment light);
 //! - `walk.rs`: the light tree re-laid out for the sampling walk (both
 //!   children of a node in one 16-byte load);
-//! - `splat.rs`: recording direct-light estimates ([`GuidingTree::splat`]);
-//! - `refine.rs`: rebuilding the cut from its sums ([`GuidingTree::refine`]);
+//! - `splat.rs`: recording direct-light estimates ([`CutRules::splat`]);
+//! - `refine.rs`: rebuilding the cut from its sums ([`CutRules::refine`]);
 //! - `config.rs`: [`CutConfig`], [`BelowCut`], [`SplitPrior`];
 //! - `standalone.rs`: [`Glt`], one cut per cell of its own spatial tree, a
 //!   [`crate::LightSampler`].
@@ -38,7 +38,7 @@
 mod config;
 mod cut;
 mod cut_node;
-mod guiding_tree;
+mod cut_rules;
 mod refine;
 mod sampling;
 mod splat;
@@ -48,7 +48,7 @@ mod walk;
 pub use config::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
 pub use cut::{CutError, CutMemory, GuidingCut};
 pub use cut_node::{CutNode, Slot};
-pub use guiding_tree::GuidingTree;
+pub use cut_rules::CutRules;
 pub use sampling::CutSampler;
 pub use splat::SplatOutcome;
 pub use standalone::{Glt, GltCell, GltConfig, GltMemory};

@@ -4,7 +4,7 @@
 use super::config::{Modulation, SplitPrior};
 use super::cut::{GuidingCut, sum_count};
 use super::cut_node::{CutNode, Slot};
-use super::guiding_tree::GuidingTree;
+use super::cut_rules::CutRules;
 use super::walk::WalkNode;
 use crate::emitter::ShadingContext;
 use crate::light_sampler::{FastQuery, ImportanceTable};
@@ -28,7 +28,7 @@ struct Task {
     old: Option<u32>,
 }
 
-impl<H: LightHierarchy> GuidingTree<H> {
+impl<H: LightHierarchy> CutRules<H> {
     /// Rebuilds `cut`'s sampled copy from the accumulated sums, then zeroes them
     /// (swapping the two copies). Returns false when the cell collected
     /// nothing from emitters: then the cut is kept as it was. A cut that
@@ -168,7 +168,7 @@ fn stored_p_left(weights: (f64, f64), importances: Option<(f64, f64)>) -> f32 {
 }
 
 fn rebuild<H: LightHierarchy>(
-    guide: &GuidingTree<H>,
+    guide: &CutRules<H>,
     old: &[CutNode],
     sums: &[f64],
     total: f64,

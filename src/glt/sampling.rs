@@ -28,12 +28,12 @@
 //! second walk. [`Rule::step`] computes the probabilities at a node and
 //! [`Rule::apply`] multiplies them in; the pmf evaluation replays exactly
 //! these two functions along the emitter's path, so the pmf `sample` returns
-//! equals [`GuidingTree::pmf_exact`] bit for bit, fallbacks included.
+//! equals [`CutRules::pmf_exact`] bit for bit, fallbacks included.
 
 use super::config::{BelowCut, CutConfig, Modulation, Prior};
 use super::cut::GuidingCut;
 use super::cut_node::CutNode;
-use super::guiding_tree::{GuidingTree, decode_split};
+use super::cut_rules::{CutRules, decode_split};
 use super::walk::WalkNode;
 use crate::emitter::ShadingContext;
 use crate::light_sampler::{FastQuery, ImportanceTable, LightId, LightSample, LightSampler};
@@ -134,7 +134,7 @@ fn pick((pl, pr): (f64, f64), side: Side) -> f64 {
 /// Everything one query needs: the guiding tree, the cell's cut nodes, the
 /// rule below the cut and the shading point.
 pub(crate) struct Rule<'b, H: LightHierarchy> {
-    guide: &'b GuidingTree<H>,
+    guide: &'b CutRules<H>,
     tree: &'b H,
     nodes: &'b [CutNode],
     below: BelowCut,
@@ -158,7 +158,7 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
     /// The rule for `cut` at `ctx`.
     #[inline]
     pub(crate) fn new(
-        guide: &'b GuidingTree<H>,
+        guide: &'b CutRules<H>,
         cut: &'b GuidingCut,
         ctx: &'b ShadingContext,
     ) -> Self {
@@ -378,7 +378,7 @@ pub(crate) fn to_light_sample(s: Option<(LightId, f64)>) -> Option<LightSample> 
     (pmf > 0.0).then_some(LightSample { light, pmf })
 }
 
-impl<H: LightHierarchy> GuidingTree<H> {
+impl<H: LightHierarchy> CutRules<H> {
     /// Chooses a light for a shading point `ctx` in the cell of `cut` from
     /// one uniform number `u` in `[0, 1)`, by the GLT's sampling rule:
     ///
@@ -398,9 +398,9 @@ impl<H: LightHierarchy> GuidingTree<H> {
         to_light_sample(self.sample_exact_from(cut, ctx, Descent::new(u)))
     }
 
-    /// Like [`GuidingTree::sample`] from an `f64` number (53 bits),
+    /// Like [`CutRules::sample`] from an `f64` number (53 bits),
     /// returning the unrounded `f64` pmf: equal, bit for bit, to
-    /// [`GuidingTree::pmf_exact`] for the chosen light.
+    /// [`CutRules::pmf_exact`] for the chosen light.
     #[inline]
     pub fn sample_exact(
         &self,
@@ -425,7 +425,7 @@ impl<H: LightHierarchy> GuidingTree<H> {
         Rule::new(self, cut, ctx).sample(d)
     }
 
-    /// The probability that [`GuidingTree::sample`] chooses `light` at `ctx`
+    /// The probability that [`CutRules::sample`] chooses `light` at `ctx`
     /// with `cut` (0 for lights it never chooses and ids out of range).
     #[inline]
     pub fn pmf(&self, cut: &GuidingCut, ctx: &ShadingContext, light: LightId) -> f32 {
@@ -448,10 +448,10 @@ impl<H: LightHierarchy> GuidingTree<H> {
     }
 }
 
-/// One cell's cut with its [`GuidingTree`], as a [`LightSampler`].
+/// One cell's cut with its [`CutRules`], as a [`LightSampler`].
 #[derive(Debug)]
 pub struct CutSampler<'b, H: LightHierarchy> {
-    guide: &'b GuidingTree<H>,
+    guide: &'b CutRules<H>,
     cut: &'b GuidingCut,
 }
 
@@ -479,7 +479,7 @@ impl<H: LightHierarchy> LightSampler for CutSampler<'_, H> {
     }
 }
 
-impl<H: LightHierarchy> GuidingTree<H> {
+impl<H: LightHierarchy> CutRules<H> {
     /// True when nothing can ever be sampled: no emitter has power and
     /// there is no environment light with a positive probability.
     pub fn is_empty(&self) -> bool {

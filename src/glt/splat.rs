@@ -2,7 +2,7 @@
 
 use super::config::Modulation;
 use super::cut::GuidingCut;
-use super::guiding_tree::GuidingTree;
+use super::cut_rules::CutRules;
 use crate::light_sampler::LightId;
 use crate::light_tree::LightHierarchy;
 use glam::Vec3;
@@ -53,7 +53,7 @@ impl GuidingCut {
     }
 }
 
-impl<H: LightHierarchy> GuidingTree<H> {
+impl<H: LightHierarchy> CutRules<H> {
     /// Records into `cut` `value`, the MIS-weighted direct-light estimate for `light`
     /// seen from a point of this cell, without BSDF and cosine: from NEE,
     /// `Le * T * w_mis / (pdf_solid_angle * pmf)`; from a BSDF-sampled
@@ -65,7 +65,7 @@ impl<H: LightHierarchy> GuidingTree<H> {
     ///
     /// The splat carries no position, so a cut trained only through this
     /// call has no anchor for [`Modulation::Importance`]; use
-    /// [`GuidingTree::splat_from`] there.
+    /// [`CutRules::splat_from`] there.
     pub fn splat(&self, cut: &GuidingCut, light: LightId, value: f32) -> SplatOutcome {
         if !(value >= 0.0 && value.is_finite()) {
             return SplatOutcome::Dropped;
@@ -92,7 +92,7 @@ impl<H: LightHierarchy> GuidingTree<H> {
         }
     }
 
-    /// [`GuidingTree::splat`] of an estimate made at the shading point
+    /// [`CutRules::splat`] of an estimate made at the shading point
     /// `from`: with [`Modulation::Importance`] a recorded splat also adds
     /// `from` to the cut's anchor (the mean position its learned weights
     /// come from). The cells of [`crate::glt::Glt`] and of the combined
@@ -107,7 +107,7 @@ impl<H: LightHierarchy> GuidingTree<H> {
         self.splat_weighted_from(cut, from, 1.0, light, value)
     }
 
-    /// [`GuidingTree::splat_from`] for the share `weight` of a splat that
+    /// [`CutRules::splat_from`] for the share `weight` of a splat that
     /// a spatial filter spread over several cells (`value` is already
     /// scaled; the anchor takes `from` with this weight).
     #[inline]

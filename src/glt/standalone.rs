@@ -5,7 +5,7 @@
 use super::config::CutConfig;
 use super::cut::{CutMemory, GuidingCut};
 use super::cut_node::CutNode;
-use super::guiding_tree::GuidingTree;
+use super::cut_rules::CutRules;
 use super::splat::SplatOutcome;
 use crate::dropped::{DropCounters, DropReason, DroppedSplats};
 use crate::emitter::ShadingContext;
@@ -107,7 +107,7 @@ pub struct GltMemory {
     /// the inline [`GltCell`] values (which include the cuts' inline parts,
     /// so those are not added twice in [`GltMemory::total`]).
     pub spatial_bytes: usize,
-    /// The [`GuidingTree`]'s split and walk tables, shared by all cells (12
+    /// The [`CutRules`]'s split and walk tables, shared by all cells (12
     /// bytes per light-tree node, plus 8).
     pub shared_bytes: usize,
 }
@@ -141,7 +141,7 @@ impl GltMemory {
 /// borrowed (`Glt<&LightTree>`).
 #[derive(Debug)]
 pub struct Glt<H: LightHierarchy> {
-    guide: GuidingTree<H>,
+    guide: CutRules<H>,
     config: GltConfig,
     spatial: BinaryTree<GltCell>,
     iteration: u32,
@@ -156,7 +156,7 @@ impl<H: LightHierarchy> Glt<H> {
     /// for empty or non-finite `scene`.
     pub fn new(tree: H, scene: Aabb, config: GltConfig) -> Result<Self, Error> {
         config.validate()?;
-        let guide = GuidingTree::new(tree, config.cut)?;
+        let guide = CutRules::new(tree, config.cut)?;
         let cell = GltCell {
             cut: guide.new_cut(),
             splats: Counter::new(),
@@ -177,7 +177,7 @@ impl<H: LightHierarchy> Glt<H> {
     }
 
     /// The guiding tree every cell's cut is used through.
-    pub fn guiding_tree(&self) -> &GuidingTree<H> {
+    pub fn cut_rules(&self) -> &CutRules<H> {
         &self.guide
     }
 
@@ -230,7 +230,7 @@ impl<H: LightHierarchy> Glt<H> {
     }
 
     /// Records a direct-light estimate `value` for `light` seen from `p` (see
-    /// [`GuidingTree::splat`] for what the value is) into the cell(s) that
+    /// [`CutRules::splat`] for what the value is) into the cell(s) that
     /// [`GltConfig::filter`] spreads `p` over: by default the cell holding
     /// `p`. With [`SpatialFilter::StochasticBox`] `p` is first jittered
     /// uniformly inside a box the size of its cell centred on it (PPG's
@@ -340,11 +340,11 @@ impl core::iter::Sum for CutMemory {
     }
 }
 
-impl<H: LightHierarchy> GuidingTree<H> {
+impl<H: LightHierarchy> CutRules<H> {
     /// Records the direct-light estimate `value` for `light` made at a point
     /// into the cuts of the cells of `cells` that `filter` spreads the point
     /// over (each cell's part `value * weight`), through
-    /// [`GuidingTree::splat`]. `at` is the point and its
+    /// [`CutRules::splat`]. `at` is the point and its
     /// `locate_with_bounds` (`None` for a non-finite point: dropped);
     /// `jitter` is that of [`BinaryTree::spread_from`]. `accepted` is called for every cell whose cut took its part
     /// ([`SplatOutcome::Recorded`] or [`SplatOutcome::Zero`]). The caller

@@ -1,5 +1,5 @@
-//! [`GuidingTree`]: what every cell's cut shares: the light tree, its power
-//! prior precomputed per inner node, and the configuration.
+//! [`CutRules`]: what every cell's cut shares: the light tree, the tables
+//! the GLT's walk reads, and the cut configuration.
 
 use super::config::CutConfig;
 use super::cut::GuidingCut;
@@ -10,12 +10,14 @@ use crate::light_tree::LightHierarchy;
 use crate::math::Descent;
 use alloc::vec::Vec;
 
-/// The global light tree prepared for guiding: the hierarchy, each inner
-/// node's power split precomputed (4 bytes per node), the tree re-laid
-/// out for sampling walks (8 bytes per node, see `src/glt/walk.rs`) and the
-/// cut configuration. One per scene; every cell's [`GuidingCut`] is sampled
-/// ([`GuidingTree::sample`]), splatted ([`GuidingTree::splat`]) and refined
-/// ([`GuidingTree::refine`]) through it.
+/// The rules every cell's cut is sampled, splatted and refined by, with the
+/// light-tree tables they read: the hierarchy, each inner node's power
+/// split precomputed (4 bytes per node), the tree re-laid out for sampling
+/// walks (8 bytes per node, see `src/glt/walk.rs`), the decoded importance
+/// table when a rule uses importance (32 bytes per node), and the cut
+/// configuration. One per scene; every cell's [`GuidingCut`] is sampled
+/// ([`CutRules::sample`]), splatted ([`CutRules::splat`]) and refined
+/// ([`CutRules::refine`]) through it.
 ///
 /// The split table is why the GLT's walk is cheaper per level than a plain
 /// power descent: the prior probabilities of a node's children come from
@@ -28,7 +30,7 @@ use alloc::vec::Vec;
 /// any positive power gets a positive probability (at least the smallest
 /// `f32`); both children dark is NaN (neither can be chosen).
 #[derive(Clone, Debug)]
-pub struct GuidingTree<H: LightHierarchy> {
+pub struct CutRules<H: LightHierarchy> {
     tree: H,
     split: Vec<f32>,
     walk: WalkTable,
@@ -75,7 +77,7 @@ pub(crate) fn decode_split(s: f32) -> Option<(f64, f64)> {
     Some((left, right))
 }
 
-impl<H: LightHierarchy> GuidingTree<H> {
+impl<H: LightHierarchy> CutRules<H> {
     /// Prepares `tree` for guiding with `config`. O(nodes). Errors for an
     /// invalid configuration ([`CutConfig::validate`]).
     pub fn new(tree: H, config: CutConfig) -> Result<Self, ConfigError> {
