@@ -1,6 +1,7 @@
 //! The same edge semantics for every light sampler: a random number outside
 //! `[0, 1)` is clamped into it and NaN counts as 0; a non-finite shading
-//! position chooses nothing (`sample` is `None`, every `pmf` is 0).
+//! position chooses nothing (`sample` is `None`, every `pmf` is 0); the
+//! exact (`f64`) variants agree bit for bit.
 
 mod common;
 
@@ -50,6 +51,12 @@ fn check(name: &str, s: &dyn LightSampler, n: u32) {
                 }
                 assert_eq!(s.pmf(&ctx, LightId::Environment), 0.0, "{name}: {bad}");
             }
+        }
+        // The exact variants: one place (the trait), the same contract.
+        let u = rng.f64();
+        if let Some((light, p)) = s.sample_exact(&ctx, u) {
+            assert_eq!(p.to_bits(), s.pmf_exact(&ctx, light).to_bits(), "{name}");
+            assert_eq!(s.pmf(&ctx, light), p as f32, "{name}");
         }
         // A non-finite normal counts as no normal.
         let no_normal = ShadingContext::at(p);

@@ -191,16 +191,13 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
         for e in [0, 17, 39, 40, 79] {
             let l = LightId::Emitter(e);
             let x = guide.pmf_exact(cut, &ctx, l).to_bits();
-            assert_eq!(v.light_pmf_exact(&ctx, l).to_bits(), x);
-            assert_eq!(field.light_pmf_exact(&ctx, l).to_bits(), x);
+            assert_eq!(v.pmf_exact(&ctx, l).to_bits(), x);
+            assert_eq!(field.pmf_exact(&ctx, l).to_bits(), x);
         }
         let u = rng.f64();
+        assert_eq!(v.sample_exact(&ctx, u), guide.sample_exact(cut, &ctx, u));
         assert_eq!(
-            v.sample_light_exact(&ctx, u),
-            guide.sample_exact(cut, &ctx, u)
-        );
-        assert_eq!(
-            field.sample_light_exact(&ctx, u),
+            field.sample_exact(&ctx, u),
             guide.sample_exact(cut, &ctx, u)
         );
     }
@@ -262,7 +259,7 @@ fn equals_a_glt_fed_the_same_light_splats() {
                 let l = LightId::Emitter(e);
                 assert_eq!(field.pmf(&ctx, l).to_bits(), glt.pmf(&ctx, l).to_bits());
                 assert_eq!(
-                    v.light_pmf_exact(&ctx, l).to_bits(),
+                    v.pmf_exact(&ctx, l).to_bits(),
                     glt.pmf_exact(&ctx, l).to_bits()
                 );
             }
@@ -370,9 +367,9 @@ proptest! {
             let ctx = ShadingContext::on_surface(p, rng.point(1.0).normalize_or(Vec3::Z));
             let v = field.vertex(p).unwrap();
             let mut total: f64 = (0..n as u32)
-                .map(|e| v.light_pmf_exact(&ctx, LightId::Emitter(e)))
+                .map(|e| v.pmf_exact(&ctx, LightId::Emitter(e)))
                 .sum();
-            total += v.light_pmf_exact(&ctx, LightId::Environment);
+            total += v.pmf_exact(&ctx, LightId::Environment);
             prop_assert!((total - 1.0).abs() < 1e-5, "pmf sums to {}", total);
             for _ in 0..20 {
                 let u = rng.f();
@@ -380,8 +377,8 @@ proptest! {
                 prop_assert_eq!(Some(s), field.sample(&ctx, u));
                 prop_assert_eq!(s.pmf.to_bits(), v.pmf(&ctx, s.light).to_bits());
                 prop_assert_eq!(s.pmf.to_bits(), field.pmf(&ctx, s.light).to_bits());
-                let (l, q) = v.sample_light_exact(&ctx, rng.f64()).unwrap();
-                prop_assert_eq!(q.to_bits(), v.light_pmf_exact(&ctx, l).to_bits());
+                let (l, q) = v.sample_exact(&ctx, rng.f64()).unwrap();
+                prop_assert_eq!(q.to_bits(), v.pmf_exact(&ctx, l).to_bits());
                 let (d, pdf) = v.sample_direction([rng.f(), rng.f()]);
                 prop_assert!(pdf > 0.0);
                 prop_assert_eq!(pdf.to_bits(), v.direction_pdf(d).to_bits());
@@ -455,7 +452,7 @@ fn direction_pdf_integrates_to_one_in_every_cell() {
     let alpha = field.config().cut.alpha;
     let ctx = ShadingContext::at(Vec3::new(-8.0, 0.0, 0.0));
     let mass: f64 = (0..40)
-        .map(|e| field.light_pmf_exact(&ctx, LightId::Emitter(e)))
+        .map(|e| field.pmf_exact(&ctx, LightId::Emitter(e)))
         .sum();
     assert!(mass > 1.0 - alpha * 0.5 - 0.02, "{mass}");
 }
@@ -511,8 +508,8 @@ fn spatial_split_copies_both_payloads() {
     // The same learned cut in both cells: the same pmf at one point (with
     // the default modulation it varies with the point, not with the cell).
     let l3 = LightId::Emitter(3);
-    let p3 = vn.light_pmf_exact(&near_ctx, l3);
-    assert_eq!(p3.to_bits(), vf.light_pmf_exact(&near_ctx, l3).to_bits());
+    let p3 = vn.pmf_exact(&near_ctx, l3);
+    assert_eq!(p3.to_bits(), vf.pmf_exact(&near_ctx, l3).to_bits());
     // A second round near p, another direction and light: only that cell
     // learns it; the far one keeps its copies.
     let dir2 = Vec3::new(1.0, -0.3, 0.0);
@@ -526,8 +523,8 @@ fn spatial_split_copies_both_payloads() {
     let (vn, vf) = (field.vertex(p).unwrap(), field.vertex(far).unwrap());
     assert!(vn.direction_pdf(dir2) > 10.0 * vf.direction_pdf(dir2));
     assert_eq!(vf.direction_pdf(dir2).to_bits(), far_pdf.to_bits());
-    assert_eq!(vf.light_pmf_exact(&near_ctx, l3).to_bits(), p3.to_bits());
-    assert!(vn.light_pmf_exact(&near_ctx, LightId::Emitter(30)) > 0.5);
+    assert_eq!(vf.pmf_exact(&near_ctx, l3).to_bits(), p3.to_bits());
+    assert!(vn.pmf_exact(&near_ctx, LightId::Emitter(30)) > 0.5);
 }
 
 /// Bad input is dropped, counted per kind and never stored, through the
@@ -625,8 +622,8 @@ fn bad_input_is_dropped_and_counted() {
     let ctx = ShadingContext::at(nan);
     assert!(field.sample(&ctx, 0.5).is_none());
     assert_eq!(field.pmf(&ctx, LightId::Emitter(0)), 0.0);
-    assert_eq!(field.light_pmf_exact(&ctx, LightId::Emitter(0)), 0.0);
-    assert!(field.sample_light_exact(&ctx, 0.5).is_none());
+    assert_eq!(field.pmf_exact(&ctx, LightId::Emitter(0)), 0.0);
+    assert!(field.sample_exact(&ctx, 0.5).is_none());
     // A refinement with nothing valid learned changes nothing.
     field.refine();
     assert_eq!(field.cell_count(), 1);

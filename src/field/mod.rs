@@ -243,20 +243,6 @@ impl<H: LightHierarchy> GuidingField<H> {
         self.sd.dropped.reset();
     }
 
-    /// Chooses a light at `ctx` from an `f64` number (53 bits), with the
-    /// unrounded pmf: equal bit for bit to [`GuidingField::light_pmf_exact`].
-    /// `None` for a non-finite position or when nothing can be chosen.
-    pub fn sample_light_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
-        let cell = self.cell_at(ctx.position)?;
-        self.guide.sample_exact(&cell.cut, ctx, u)
-    }
-
-    /// The unrounded pmf of `light` at `ctx` (0 at a non-finite position).
-    pub fn light_pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
-        self.cell_at(ctx.position)
-            .map_or(0.0, |cell| self.guide.pmf_exact(&cell.cut, ctx, light))
-    }
-
     /// A light splat through the shared GLT record, counting a drop.
     #[inline]
     fn record_light(
@@ -292,5 +278,17 @@ impl<H: LightHierarchy> LightSampler for GuidingField<H> {
 
     fn is_empty(&self) -> bool {
         self.guide.is_empty()
+    }
+
+    #[inline]
+    fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
+        self.guide
+            .sample_exact(&self.cell_at(ctx.position)?.cut, ctx, u)
+    }
+
+    #[inline]
+    fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
+        self.cell_at(ctx.position)
+            .map_or(0.0, |cell| self.guide.pmf_exact(&cell.cut, ctx, light))
     }
 }

@@ -107,19 +107,6 @@ impl<'f, H: LightHierarchy> FieldVertex<'f, H> {
         self.cell.sd.mixture_pdf(dir, bsdf_pdf)
     }
 
-    /// Chooses a light from an `f64` number with the unrounded pmf (equal
-    /// bit for bit to [`FieldVertex::light_pmf_exact`]).
-    #[inline]
-    pub fn sample_light_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
-        self.field.guide.sample_exact(&self.cell.cut, ctx, u)
-    }
-
-    /// The unrounded pmf of `light`.
-    #[inline]
-    pub fn light_pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
-        self.field.guide.pmf_exact(&self.cell.cut, ctx, light)
-    }
-
     /// [`GuidingField::splat_radiance`] at this vertex's position.
     #[inline]
     pub fn splat_radiance<R: Rng + ?Sized>(
@@ -169,5 +156,15 @@ impl<H: LightHierarchy> LightSampler for FieldVertex<'_, H> {
 
     fn is_empty(&self) -> bool {
         self.field.guide.is_empty()
+    }
+
+    #[inline]
+    fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
+        self.field.guide.sample_exact(&self.cell.cut, ctx, u)
+    }
+
+    #[inline]
+    fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
+        self.field.guide.pmf_exact(&self.cell.cut, ctx, light)
     }
 }

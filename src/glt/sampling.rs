@@ -477,6 +477,16 @@ impl<H: LightHierarchy> LightSampler for CutSampler<'_, H> {
     fn is_empty(&self) -> bool {
         self.guide.is_empty()
     }
+
+    #[inline]
+    fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
+        self.guide.sample_exact(self.cut, ctx, u)
+    }
+
+    #[inline]
+    fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
+        self.guide.pmf_exact(self.cut, ctx, light)
+    }
 }
 
 impl<H: LightHierarchy> CutRules<H> {

@@ -215,20 +215,6 @@ impl<H: LightHierarchy> Glt<H> {
         self.dropped.reset();
     }
 
-    /// Chooses a light at `ctx` from an `f64` number (53 bits), with the
-    /// unrounded pmf: equal bit for bit to [`Glt::pmf_exact`].
-    pub fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
-        self.guide.sample_exact(self.cut_at(ctx.position)?, ctx, u)
-    }
-
-    /// The unrounded pmf of `light` at `ctx`.
-    pub fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
-        match self.cut_at(ctx.position) {
-            Some(cut) => self.guide.pmf_exact(cut, ctx, light),
-            None => 0.0,
-        }
-    }
-
     /// Records a direct-light estimate `value` for `light` seen from `p` (see
     /// [`CutRules::splat`] for what the value is) into the cell(s) that
     /// [`GltConfig::filter`] spreads `p` over: by default the cell holding
@@ -397,5 +383,16 @@ impl<H: LightHierarchy> LightSampler for Glt<H> {
 
     fn is_empty(&self) -> bool {
         self.guide.is_empty()
+    }
+
+    #[inline]
+    fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
+        self.guide.sample_exact(self.cut_at(ctx.position)?, ctx, u)
+    }
+
+    #[inline]
+    fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
+        self.cut_at(ctx.position)
+            .map_or(0.0, |cut| self.guide.pmf_exact(cut, ctx, light))
     }
 }

@@ -77,6 +77,21 @@ pub trait LightSampler {
 
     /// True when `sample` returns `None` at every shading point.
     fn is_empty(&self) -> bool;
+
+    /// [`LightSampler::sample`] from an `f64` number (53 bits), returning
+    /// the pmf before it is rounded to `f32`: equal bit for bit to
+    /// [`LightSampler::pmf_exact`] of the chosen light. The GLT's samplers
+    /// compute in `f64` and override this; the default widens `sample`.
+    fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
+        self.sample(ctx, u as f32)
+            .map(|s| (s.light, f64::from(s.pmf)))
+    }
+
+    /// The pmf before rounding to `f32` (see
+    /// [`LightSampler::sample_exact`]); the default widens `pmf`.
+    fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
+        f64::from(self.pmf(ctx, light))
+    }
 }
 
 impl<S: LightSampler + ?Sized> LightSampler for &S {
@@ -94,6 +109,16 @@ impl<S: LightSampler + ?Sized> LightSampler for &S {
     fn is_empty(&self) -> bool {
         (**self).is_empty()
     }
+
+    #[inline]
+    fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
+        (**self).sample_exact(ctx, u)
+    }
+
+    #[inline]
+    fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
+        (**self).pmf_exact(ctx, light)
+    }
 }
 
 impl<S: LightSampler + ?Sized> LightSampler for alloc::boxed::Box<S> {
@@ -110,5 +135,15 @@ impl<S: LightSampler + ?Sized> LightSampler for alloc::boxed::Box<S> {
     #[inline]
     fn is_empty(&self) -> bool {
         (**self).is_empty()
+    }
+
+    #[inline]
+    fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
+        (**self).sample_exact(ctx, u)
+    }
+
+    #[inline]
+    fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
+        (**self).pmf_exact(ctx, light)
     }
 }
