@@ -237,7 +237,7 @@ fn bad_splats_are_counted() {
     assert_eq!(glt.dropped_splats().total(), 16);
     glt.reset_dropped_splats();
     assert_eq!(glt.dropped_splats().total(), 0);
-    let (emitters, env) = glt.cut_at(p).unwrap().accumulated();
+    let (emitters, env) = glt.vertex(p).unwrap().cut().accumulated();
     assert_eq!((emitters, env), (1.0, 0.0));
     assert_eq!(glt.spatial().data_slice()[0].splats(), 2);
     // Queries at non-finite points: nothing, consistently.

@@ -167,7 +167,7 @@ fn spatial_split_exactly_above_threshold_copies_and_halves() {
     // Iteration 0: threshold c = 100.
     let mut t = SdTree::new(scene(), config(100.0)).unwrap();
     splat_n(&t, p, 100);
-    assert_eq!(t.cell_at(p).unwrap().building_weight(), 100.0);
+    assert_eq!(t.vertex(p).unwrap().sd().building_weight(), 100.0);
     assert_eq!(t.refine().splits, 0);
     assert_eq!(t.cell_count(), 1);
     // Iteration 1: threshold 100 sqrt 2 = 141.42.
@@ -312,14 +312,14 @@ fn bad_input_is_dropped_counted_and_never_stored() {
     assert_eq!(dropped.total(), 4 + 3 + 7 + 7 + 1);
     // Nothing was stored: no weight, nothing learned, no split, fraction
     // unchanged.
-    assert_eq!(t.cell_at(p).unwrap().building_weight(), 0.0);
+    assert_eq!(t.vertex(p).unwrap().sd().building_weight(), 0.0);
     t.refine();
     assert_eq!(t.cell_count(), 1);
     assert_eq!(t.pdf(p, Vec3::X), UNIFORM_PDF);
     assert_eq!(t.bsdf_fraction(p), 0.5);
     // Valid zero radiance counts weight, no power.
     assert!(t.splat(p, d, 0.0, 1.0, &mut rng));
-    assert_eq!(t.cell_at(p).unwrap().building_weight(), 1.0);
+    assert_eq!(t.vertex(p).unwrap().sd().building_weight(), 1.0);
     t.reset_dropped_splats();
     assert_eq!(t.dropped_splats().total(), 0);
     // Learning disabled: records are refused but not counted.

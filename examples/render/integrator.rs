@@ -246,7 +246,7 @@ pub fn radiance<'a>(
         };
         let cell = match (field_vertex, guides.sd_tree) {
             (Some(v), _) => Some(DirGuide::Field(v)),
-            (None, Some(t)) => t.cell_at(p).map(DirGuide::Sd),
+            (None, Some(t)) => t.vertex(p).map(|v| DirGuide::Sd(v.sd())),
             (None, None) => None,
         };
         let frac = cell.map_or(1.0, |c| c.fraction());

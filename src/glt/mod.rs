@@ -51,4 +51,4 @@ pub use cut_node::{CutNode, Slot};
 pub use cut_rules::CutRules;
 pub use sampling::CutSampler;
 pub use splat::SplatOutcome;
-pub use standalone::{Glt, GltCell, GltConfig, GltMemory};
+pub use standalone::{Glt, GltCell, GltConfig, GltMemory, GltVertex};

@@ -198,7 +198,7 @@ impl<H: LightHierarchy> Glt<H> {
 
     /// The cut of the cell holding `p` (`None` for a non-finite point).
     #[inline]
-    pub fn cut_at(&self, p: Vec3) -> Option<&GuidingCut> {
+    pub(crate) fn cut_at(&self, p: Vec3) -> Option<&GuidingCut> {
         let cell = self.spatial.locate(p)?;
         Some(&self.spatial.data(cell).cut)
     }
@@ -231,24 +231,27 @@ impl<H: LightHierarchy> Glt<H> {
         value: f32,
         rng: &mut R,
     ) -> SplatOutcome {
-        self.splat_filtered(p, light, value, self.config.filter, || jitter_u64(rng))
+        let at = self.spatial.locate_with_bounds(p);
+        self.splat_filtered(p, at, light, value, self.config.filter, || jitter_u64(rng))
     }
 
     /// Like [`Glt::splat`] with [`SpatialFilter::Nearest`] whatever the
     /// configuration: the estimate goes to the cell holding `p`.
     pub fn splat_at(&self, p: Vec3, light: LightId, value: f32) -> SplatOutcome {
-        self.splat_filtered(p, light, value, SpatialFilter::Nearest, || Vec3::ZERO)
+        let at = self.spatial.locate_with_bounds(p);
+        self.splat_filtered(p, at, light, value, SpatialFilter::Nearest, || Vec3::ZERO)
     }
 
-    fn splat_filtered(
+    /// A light splat from `p`, located at `at` (`None`: non-finite `p`).
+    pub(super) fn splat_filtered(
         &self,
         p: Vec3,
+        at: Option<(CellId, Aabb)>,
         light: LightId,
         value: f32,
         filter: SpatialFilter,
         jitter: impl FnOnce() -> Vec3,
     ) -> SplatOutcome {
-        let at = self.spatial.locate_with_bounds(p);
         let outcome = self.guide.splat_spread(
             &self.spatial,
             (p, at),
@@ -314,6 +317,20 @@ impl<H: LightHierarchy> Glt<H> {
     /// The cell holding `p`, `None` for a non-finite point.
     pub fn locate(&self, p: Vec3) -> Option<CellId> {
         self.spatial.locate(p)
+    }
+
+    /// The one lookup per path vertex: the cell holding `p` (clamped onto
+    /// the root cube), through which light selection and light splats at
+    /// `p` go. `None` for a non-finite `p`.
+    #[inline]
+    pub fn vertex(&self, p: Vec3) -> Option<GltVertex<'_, H>> {
+        let at = self.spatial.locate_with_bounds(p)?;
+        Some(GltVertex {
+            glt: self,
+            cut: &self.spatial.data(at.0).cut,
+            p,
+            at,
+        })
     }
 }
 
@@ -394,5 +411,88 @@ impl<H: LightHierarchy> LightSampler for Glt<H> {
     fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
         self.cut_at(ctx.position)
             .map_or(0.0, |cut| self.guide.pmf_exact(cut, ctx, light))
+    }
+}
+
+/// A path vertex located in a [`Glt`] ([`Glt::vertex`]): light selection
+/// and light splats at that point without looking the cell up again, as
+/// [`FieldVertex`](crate::field::FieldVertex) does for the combined field.
+/// Every answer equals the GLT's by position at the same point.
+#[derive(Debug)]
+pub struct GltVertex<'g, H: LightHierarchy> {
+    glt: &'g Glt<H>,
+    cut: &'g GuidingCut,
+    p: Vec3,
+    at: (CellId, Aabb),
+}
+
+impl<H: LightHierarchy> Clone for GltVertex<'_, H> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<H: LightHierarchy> Copy for GltVertex<'_, H> {}
+
+impl<'g, H: LightHierarchy> GltVertex<'g, H> {
+    /// The point this vertex was located from.
+    #[inline]
+    pub fn position(&self) -> Vec3 {
+        self.p
+    }
+
+    /// The cell's number.
+    #[inline]
+    pub fn cell(&self) -> CellId {
+        self.at.0
+    }
+
+    /// The located cell's cut.
+    #[inline]
+    pub fn cut(&self) -> &'g GuidingCut {
+        self.cut
+    }
+
+    /// [`Glt::splat`] at this vertex's position: a direct-light estimate
+    /// `value` for `light` (`Le * w_mis / pmf` for NEE, see
+    /// [`CutRules::splat`]).
+    #[inline]
+    pub fn splat_light<R: Rng + ?Sized>(
+        &self,
+        light: LightId,
+        value: f32,
+        rng: &mut R,
+    ) -> SplatOutcome {
+        let g = self.glt;
+        g.splat_filtered(self.p, Some(self.at), light, value, g.config.filter, || {
+            jitter_u64(rng)
+        })
+    }
+}
+
+impl<H: LightHierarchy> LightSampler for GltVertex<'_, H> {
+    /// Applies the GLT's sampling rule with the located cell's cut.
+    #[inline]
+    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+        self.glt.guide.sample(self.cut, ctx, u)
+    }
+
+    #[inline]
+    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        self.glt.guide.pmf(self.cut, ctx, light)
+    }
+
+    fn is_empty(&self) -> bool {
+        self.glt.guide.is_empty()
+    }
+
+    #[inline]
+    fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
+        self.glt.guide.sample_exact(self.cut, ctx, u)
+    }
+
+    #[inline]
+    fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
+        self.glt.guide.pmf_exact(self.cut, ctx, light)
     }
 }

@@ -113,11 +113,13 @@ mod refine;
 mod splat;
 mod state;
 mod validate;
+mod vertex;
 
 pub use cell::SdCell;
 pub use config::SdTreeConfig;
 pub use memory::SdTreeMemory;
 pub(crate) use state::SdState;
+pub use vertex::SdVertex;
 
 use crate::dropped::DroppedSplats;
 use crate::error::Error;

@@ -8,7 +8,7 @@ impl SdTree {
     /// The cell holding `p` (clamped into the scene); `None` for a
     /// non-finite `p`.
     #[inline]
-    pub fn cell_at(&self, p: Vec3) -> Option<&SdCell> {
+    pub(crate) fn cell_at(&self, p: Vec3) -> Option<&SdCell> {
         self.tree.locate(p).map(|c| self.tree.data(c))
     }
 
