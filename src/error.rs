@@ -2,6 +2,7 @@
 //! configuration ([`ConfigError`]) or scene bounds no spatial tree can
 //! start from ([`SpatialError`]).
 
+use crate::light_tree::BuildError;
 use crate::spatial::SpatialError;
 
 /// A configuration field outside its valid range. Constructors check every
@@ -36,11 +37,22 @@ pub enum Error {
     Config(ConfigError),
     /// The scene bounds are empty or not finite.
     Spatial(SpatialError),
+    /// No light tree can be built from the emitters.
+    Build(BuildError),
+    /// [`Strategy::new`](crate::Strategy::new) was given a name it does
+    /// not know.
+    UnknownStrategy,
 }
 
 impl From<ConfigError> for Error {
     fn from(e: ConfigError) -> Self {
         Self::Config(e)
+    }
+}
+
+impl From<BuildError> for Error {
+    fn from(e: BuildError) -> Self {
+        Self::Build(e)
     }
 }
 
@@ -55,6 +67,12 @@ impl core::fmt::Display for Error {
         match self {
             Self::Config(e) => e.fmt(f),
             Self::Spatial(e) => e.fmt(f),
+            Self::Build(e) => e.fmt(f),
+            Self::UnknownStrategy => write!(
+                f,
+                "unknown light sampling strategy (expected one of {:?})",
+                crate::Strategy::NAMES
+            ),
         }
     }
 }
@@ -65,6 +83,8 @@ impl std::error::Error for Error {
         match self {
             Self::Config(e) => Some(e),
             Self::Spatial(e) => Some(e),
+            Self::Build(e) => Some(e),
+            Self::UnknownStrategy => None,
         }
     }
 }

@@ -63,6 +63,7 @@ pub mod quadtree;
 pub mod schedule;
 pub mod sd_tree;
 pub mod spatial;
+mod strategy;
 
 /// The vector types of the public API (`Vec3`, ...): glam 0.34, re-exported
 /// so a renderer on another glam version names the crate's own.
@@ -81,3 +82,4 @@ pub use light_sampler::{
 };
 pub use light_tree::{LightHierarchy, LightTree};
 pub use path_recorder::PathRecorder;
+pub use strategy::Strategy;

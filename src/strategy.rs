@@ -1,0 +1,119 @@
+//! [`Strategy`]: a light sampler chosen by name, as pbrt's
+//! `lightsamplestrategy`, owning everything it needs.
+
+use crate::emitter::{Emitters, ShadingContext};
+use crate::error::Error;
+use crate::glt::{Glt, GltConfig};
+use crate::light_sampler::{
+    ImportanceTreeSampler, LightId, LightSample, LightSampler, PowerSampler, UniformSampler,
+};
+use crate::light_tree::{BuildHeuristic, LightTree};
+use crate::math::Aabb;
+
+/// A light-selection strategy by name: `"uniform"`, `"power"`,
+/// `"importance"` (the light BVH of Estevez-Kulla and pbrt-v4) or `"glt"`
+/// (the Guiding Light Tree, with its training side through
+/// [`Strategy::glt_mut`]). It owns its light tree, is `Send + Sync`, and
+/// samples exactly as the sampler it wraps.
+///
+/// ```
+/// use guiding::{glam::Vec3, math::Aabb, Emitter, LightSampler, ShadingContext, Strategy};
+/// let lights = [Emitter::point(Vec3::Y, 1.0), Emitter::point(Vec3::X, 3.0)];
+/// let scene = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
+/// let s = Strategy::new("power", &lights[..], scene)?;
+/// let ctx = ShadingContext::at(Vec3::ZERO);
+/// assert_eq!(s.pmf(&ctx, guiding::LightId::Emitter(1)), 0.75);
+/// assert!(Strategy::new("bvh-2000", &lights[..], scene).is_err());
+/// # Ok::<(), guiding::Error>(())
+/// ```
+#[derive(Debug)]
+pub enum Strategy {
+    /// Every emitter equally.
+    Uniform(UniformSampler),
+    /// In proportion to power.
+    Power(PowerSampler),
+    /// Descending the light tree by importance at the shading point.
+    Importance(ImportanceTreeSampler<LightTree>),
+    /// The Guiding Light Tree (learns; refine it between iterations).
+    Glt(alloc::boxed::Box<Glt<LightTree>>),
+}
+
+impl Strategy {
+    /// The names [`Strategy::new`] accepts.
+    pub const NAMES: [&'static str; 4] = ["uniform", "power", "importance", "glt"];
+
+    /// The strategy called `name` over `emitters`; `scene` bounds the
+    /// shading points (used by `"glt"`, with [`GltConfig::default`]).
+    /// Errors for an unknown name and for emitters a light tree cannot be
+    /// built from (`"importance"`, `"glt"`).
+    pub fn new<E: Emitters + ?Sized>(name: &str, emitters: &E, scene: Aabb) -> Result<Self, Error> {
+        let tree = || LightTree::build(emitters, BuildHeuristic::default()).map_err(Error::Build);
+        Ok(match name {
+            "uniform" => Self::Uniform(UniformSampler::new(emitters.len())),
+            "power" => Self::Power(PowerSampler::new(emitters)),
+            "importance" => Self::Importance(ImportanceTreeSampler::new(tree()?)),
+            "glt" => Self::Glt(alloc::boxed::Box::new(Glt::new(
+                tree()?,
+                scene,
+                GltConfig::default(),
+            )?)),
+            _ => return Err(Error::UnknownStrategy),
+        })
+    }
+
+    /// Its name (one of [`Strategy::NAMES`]).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Uniform(_) => "uniform",
+            Self::Power(_) => "power",
+            Self::Importance(_) => "importance",
+            Self::Glt(_) => "glt",
+        }
+    }
+
+    /// The GLT, for its training side (splats, refine); `None` for the
+    /// strategies that do not learn.
+    pub fn glt_mut(&mut self) -> Option<&mut Glt<LightTree>> {
+        match self {
+            Self::Glt(g) => Some(&mut **g),
+            _ => None,
+        }
+    }
+
+    /// The sampler inside, as a trait object.
+    #[inline]
+    fn sampler(&self) -> &dyn LightSampler {
+        match self {
+            Self::Uniform(s) => s,
+            Self::Power(s) => s,
+            Self::Importance(s) => s,
+            Self::Glt(s) => &**s,
+        }
+    }
+}
+
+impl LightSampler for Strategy {
+    #[inline]
+    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+        self.sampler().sample(ctx, u)
+    }
+
+    #[inline]
+    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        self.sampler().pmf(ctx, light)
+    }
+
+    fn is_empty(&self) -> bool {
+        self.sampler().is_empty()
+    }
+
+    #[inline]
+    fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
+        self.sampler().sample_exact(ctx, u)
+    }
+
+    #[inline]
+    fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
+        self.sampler().pmf_exact(ctx, light)
+    }
+}

@@ -1,0 +1,91 @@
+//! A strategy by name samples exactly as the sampler it names, owns its
+//! tree, and reports unknown names and unbuildable emitters as errors.
+
+mod common;
+
+use common::{Rand, scene, two_rooms, value};
+use glam::Vec3;
+use guiding::glt::{Glt, GltConfig};
+use guiding::light_tree::{BuildError, BuildHeuristic};
+use guiding::{
+    Emitter, Error, ImportanceTreeSampler, LightId, LightSampler, LightTree, PowerSampler,
+    ShadingContext, Strategy, UniformSampler,
+};
+
+#[test]
+fn each_name_is_its_sampler() {
+    fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<Strategy>();
+    let lights = two_rooms();
+    let tree = LightTree::build(&lights, BuildHeuristic::default()).unwrap();
+    let direct: [Box<dyn LightSampler>; 4] = [
+        Box::new(UniformSampler::new(lights.len())),
+        Box::new(PowerSampler::new(&lights[..])),
+        Box::new(ImportanceTreeSampler::new(&tree)),
+        Box::new(Glt::new(&tree, scene(), GltConfig::default()).unwrap()),
+    ];
+    let mut rng = Rand::new(3);
+    for (name, reference) in Strategy::NAMES.iter().zip(&direct) {
+        let s = Strategy::new(name, &lights[..], scene()).unwrap();
+        assert_eq!(s.name(), *name);
+        assert_eq!(s.is_empty(), reference.is_empty());
+        for _ in 0..200 {
+            let ctx = ShadingContext::on_surface(rng.point(9.0), rng.dir());
+            let u = rng.f();
+            let x = s.sample(&ctx, u);
+            assert_eq!(x, reference.sample(&ctx, u), "{name}");
+            let x = x.unwrap();
+            assert_eq!(s.pmf(&ctx, x.light), x.pmf, "{name}");
+        }
+    }
+}
+
+#[test]
+fn the_glt_strategy_trains() {
+    let lights = two_rooms();
+    let mut s = Strategy::new("glt", &lights[..], scene()).unwrap();
+    let ctx = ShadingContext::at(Vec3::new(-5.0, 0.0, 0.0));
+    let right = |s: &Strategy| -> f32 { (40..80).map(|e| s.pmf(&ctx, LightId::Emitter(e))).sum() };
+    let before = right(&s);
+    assert!(
+        Strategy::new("power", &lights[..], scene())
+            .unwrap()
+            .glt_mut()
+            .is_none()
+    );
+    let mut rng = Rand::new(1);
+    // Enough splats per iteration for the default threshold (12000) to
+    // split the scene at the wall.
+    for _ in 0..4 {
+        let glt = s.glt_mut().unwrap();
+        for _ in 0..40000 {
+            let p = rng.point(9.5);
+            let x = glt.sample(&ShadingContext::at(p), rng.f()).unwrap();
+            let LightId::Emitter(e) = x.light else {
+                panic!()
+            };
+            glt.splat(p, x.light, value(&lights, e, p) / x.pmf, &mut rng.0);
+        }
+        glt.refine();
+    }
+    // Learned: from the left room, the right room's lights (behind the
+    // wall) became rare.
+    let after = right(&s);
+    assert!(after < 0.5 * before, "{before} -> {after}");
+}
+
+#[test]
+fn errors_are_typed() {
+    let lights = two_rooms();
+    assert_eq!(
+        Strategy::new("bvh", &lights[..], scene()).unwrap_err(),
+        Error::UnknownStrategy
+    );
+    let bad = [Emitter::point(Vec3::ZERO, f32::NAN)];
+    for name in ["importance", "glt"] {
+        assert!(matches!(
+            Strategy::new(name, &bad[..], scene()),
+            Err(Error::Build(BuildError::InvalidPower { emitter: 0, .. }))
+        ));
+    }
+}
