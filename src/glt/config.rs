@@ -16,11 +16,10 @@ pub enum BelowCut {
     /// work. Where both children have zero importance the step falls back to
     /// power, so the cut component stays a proper distribution.
     ///
-    /// Measured in the synthetic scene described at [`CutConfig::alpha`]
-    /// (`tests/glt_defaults.rs`): 1.5-2.5x lower variance than
-    /// [`BelowCut::Power`] at equal alpha, for a costlier walk below the
-    /// cut (two importance evaluations per level). The default, with the
-    /// other importance rules (see [`CutConfig::with_importance`]).
+    /// Lower variance than [`BelowCut::Power`] for a costlier walk below
+    /// the cut (two importance evaluations per level); measured in
+    /// docs/results.md, "Defaults of the cut". The default, with the other
+    /// importance rules (see [`CutConfig::with_importance`]).
     #[default]
     Importance,
 }
@@ -88,12 +87,10 @@ pub enum Prior {
 /// the cut into lights that cannot be sampled below it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum SplitPrior {
-    /// Half each, as the paper and its code do. The default, measured
-    /// (`tests/glt_defaults.rs`, 2 training budgets x 2 seeds): against
-    /// [`SplitPrior::Power`] it gave 0.70-1.04x the variance with power
-    /// below the cut and 0.82-1.10x with importance (at alpha = 0.2; 6 of 8
-    /// runs lower), most clearly when cells have little data: a fresh split
-    /// that ignores power explores dim but near clusters sooner.
+    /// Half each, as the paper and its code do. The default: a fresh split
+    /// that ignores power explores dim but near clusters sooner, which
+    /// helps most when cells have little data (measured in
+    /// docs/results.md, "Defaults of the cut").
     #[default]
     Half,
     /// In the ratio of the children's subtree powers: a freshly split
@@ -121,16 +118,11 @@ pub struct CutConfig {
     /// defensive importance sampling bound), while a perfectly learned
     /// distribution loses at most a factor `1 / (1 - alpha)` in variance.
     ///
-    /// Default 0.2, measured (`tests/glt_defaults.rs`: 2000 lights in rooms,
-    /// exact variance over 300 points; power below the cut, half splits):
-    /// the relative variance at alpha = 0.05 / 0.1 / 0.2 / 0.3 / 0.5 was
-    /// 25 / 14-16 / 9.4-11 / 11 / 10.5-11 with little training and
-    /// 7.7-7.9 / 4.6-5.1 / 3.9-4.3 / 3.6 / 4.1-4.3 with ten times more
-    /// (pure prior: 69). Cells learn from few samples, so clusters that
-    /// matter but drew no splat must be caught by the floor; 0.2-0.3 is
-    /// best, and 0.2 costs at most 1.25x against a perfect guide. 0 gives
-    /// the paper's behaviour (biased for delta lights the cut never
-    /// learned).
+    /// Default 0.2: cells learn from few samples, so clusters that matter
+    /// but drew no splat must be caught by the floor, and 0.2 costs at most
+    /// 1.25x against a perfect guide (measured in docs/results.md,
+    /// "Defaults of the cut"). 0 gives the paper's behaviour (biased for
+    /// delta lights the cut never learned).
     pub alpha: f64,
     /// How to continue below the cut. Default [`BelowCut::Importance`].
     pub below_cut: BelowCut,
