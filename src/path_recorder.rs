@@ -31,9 +31,9 @@
 use crate::field::{FieldVertex, GuidingField};
 use crate::light_tree::LightHierarchy;
 use crate::sd_tree::SdTree;
+use crate::spatial::Jitter;
 use alloc::vec::Vec;
 use glam::Vec3;
-use rand_core::Rng;
 
 /// The luminance of linear Rec. 709 RGB, the scalar the recorder delivers
 /// radiance as (`0.2126 r + 0.7152 g + 0.0722 b`).
@@ -102,39 +102,39 @@ pub trait RadianceRecords<C> {
     /// `luminance(segment.incident)`, `contribution` is
     /// `luminance(segment.weight * segment.incident)` (what the learned
     /// BSDF fraction optimises).
-    fn record<R: Rng + ?Sized>(
+    fn record<J: Jitter + ?Sized>(
         &self,
         segment: &Segment<C>,
         radiance: f32,
         contribution: f32,
-        rng: &mut R,
+        jitter: &mut J,
     );
 }
 
 impl RadianceRecords<()> for SdTree {
     #[inline]
-    fn record<R: Rng + ?Sized>(
+    fn record<J: Jitter + ?Sized>(
         &self,
         s: &Segment<()>,
         radiance: f32,
         contribution: f32,
-        rng: &mut R,
+        jitter: &mut J,
     ) {
-        self.splat(s.position, s.direction, radiance, s.pdf, rng);
+        self.splat(s.position, s.direction, radiance, s.pdf, jitter);
         self.record_fraction(s.position, s.bsdf_pdf, s.guide_pdf, contribution);
     }
 }
 
 impl<'f, H: LightHierarchy> RadianceRecords<FieldVertex<'f, H>> for GuidingField<H> {
     #[inline]
-    fn record<R: Rng + ?Sized>(
+    fn record<J: Jitter + ?Sized>(
         &self,
         s: &Segment<FieldVertex<'f, H>>,
         radiance: f32,
         contribution: f32,
-        rng: &mut R,
+        jitter: &mut J,
     ) {
-        s.cell.splat_radiance(s.direction, radiance, s.pdf, rng);
+        s.cell.splat_radiance(s.direction, radiance, s.pdf, jitter);
         s.cell
             .record_fraction(s.bsdf_pdf, s.guide_pdf, contribution);
     }
@@ -250,10 +250,10 @@ impl<C> PathRecorder<C> {
 
     /// Computes the radiance that arrived along every segment and hands
     /// each one with a finite, non-negative value to `records`.
-    pub fn finish<S: RadianceRecords<C> + ?Sized, R: Rng + ?Sized>(
+    pub fn finish<S: RadianceRecords<C> + ?Sized, J: Jitter + ?Sized>(
         &mut self,
         records: &S,
-        rng: &mut R,
+        jitter: &mut J,
     ) {
         // L_i = found_i + factor_i w_(i+1) L_(i+1), from the last segment.
         let mut after = Vec3::ZERO;
@@ -266,7 +266,7 @@ impl<C> PathRecorder<C> {
         for s in &self.segments {
             if s.incident.is_finite() {
                 let radiance = luminance(s.incident);
-                records.record(s, radiance, luminance(s.weight * s.incident), rng);
+                records.record(s, radiance, luminance(s.weight * s.incident), jitter);
             }
         }
     }

@@ -10,8 +10,8 @@ use glam::Vec3;
 use guiding::math::Aabb;
 use guiding::path_recorder::{RadianceRecords, Segment};
 use guiding::sd_tree::{SdTree, SdTreeConfig};
+use guiding::spatial::Jitter;
 use guiding::{PathRecorder, mis};
-use rand_core::Rng;
 use std::cell::RefCell;
 
 /// One event of a random path.
@@ -27,12 +27,12 @@ enum Event {
 struct Collect(RefCell<Vec<(u32, Vec3, f32, f32)>>);
 
 impl RadianceRecords<u32> for Collect {
-    fn record<R: Rng + ?Sized>(
+    fn record<J: Jitter + ?Sized>(
         &self,
         s: &Segment<u32>,
         radiance: f32,
         contribution: f32,
-        _: &mut R,
+        _: &mut J,
     ) {
         self.0
             .borrow_mut()

@@ -15,8 +15,8 @@ use guiding::field::{FieldVertex, GuidingField};
 use guiding::glt::Glt;
 use guiding::mis::power_heuristic;
 use guiding::path_recorder::{RadianceRecords, Segment};
-use guiding::rand_core::Rng;
 use guiding::sd_tree::{SdCell, SdTree};
+use guiding::spatial::Jitter;
 use guiding::{LightId, LightSampler, LightTree, PathRecorder, ShadingContext};
 
 /// What a path consults and trains.
@@ -50,17 +50,17 @@ pub type Recorder<'a> = PathRecorder<Option<Located<'a>>>;
 /// Where the recorder's segments go: the SD-tree, or the field through the
 /// vertex each segment kept.
 impl<'a> RadianceRecords<Option<Located<'a>>> for Guides<'a> {
-    fn record<R: Rng + ?Sized>(
+    fn record<J: Jitter + ?Sized>(
         &self,
         seg: &Segment<Option<Located<'a>>>,
         radiance: f32,
         contribution: f32,
-        rng: &mut R,
+        jitter: &mut J,
     ) {
         if let Some(t) = self.sd_tree {
-            t.record(&seg.with_cell(()), radiance, contribution, rng);
+            t.record(&seg.with_cell(()), radiance, contribution, jitter);
         } else if let (Some(field), Some(v)) = (self.field, seg.cell) {
-            field.record(&seg.with_cell(v), radiance, contribution, rng);
+            field.record(&seg.with_cell(v), radiance, contribution, jitter);
         }
     }
 }

@@ -5,44 +5,44 @@ use super::GuidingField;
 use crate::glt::SplatOutcome;
 use crate::light_sampler::LightId;
 use crate::light_tree::LightHierarchy;
-use crate::spatial::{SpatialFilter, jitter_u64};
+use crate::spatial::Jitter;
+use crate::spatial::{SpatialFilter, jitter_offset};
 use glam::Vec3;
-use rand_core::Rng;
 
 impl<H: LightHierarchy> GuidingField<H> {
     /// PPG's record, exactly as [`SdTree::splat`](crate::sd_tree::SdTree::splat):
     /// `radiance / pdf` into the quadtree of the cell at `p` along `dir`,
-    /// statistical weight 1, spread by the configured SD filters (`rng` is
+    /// statistical weight 1, spread by the configured SD filters (`jitter` is
     /// used by the stochastic box only). Returns false, counting the reason
     /// in [`GuidingField::dropped_splats`], for invalid input.
     #[inline]
-    pub fn splat_radiance<R: Rng + ?Sized>(
+    pub fn splat_radiance<J: Jitter + ?Sized>(
         &self,
         p: Vec3,
         dir: Vec3,
         radiance: f32,
         pdf: f32,
-        rng: &mut R,
+        jitter: &mut J,
     ) -> bool {
         let at = self.cells.locate_with_bounds(p);
-        self.splat_radiance_from(p, at, dir, radiance, pdf, rng)
+        self.splat_radiance_from(p, at, dir, radiance, pdf, jitter)
     }
 
     /// [`GuidingField::splat_radiance`] for a located point.
     #[inline]
-    pub(super) fn splat_radiance_from<R: Rng + ?Sized>(
+    pub(super) fn splat_radiance_from<J: Jitter + ?Sized>(
         &self,
         p: Vec3,
         at: Option<(crate::spatial::CellId, crate::math::Aabb)>,
         dir: Vec3,
         radiance: f32,
         pdf: f32,
-        rng: &mut R,
+        jitter: &mut J,
     ) -> bool {
         let c = &self.sd.config;
         let filters = (c.spatial_filter, c.directional_filter);
         self.sd
-            .splat(&self.cells, p, at, dir, radiance, pdf, filters, rng)
+            .splat(&self.cells, p, at, dir, radiance, pdf, filters, jitter)
     }
 
     /// The GLT's record, as [`Glt::splat`](crate::glt::Glt::splat): the
@@ -51,19 +51,19 @@ impl<H: LightHierarchy> GuidingField<H> {
     /// is) into the cut of the cell(s) that
     /// [`FieldConfig::light_filter`](super::FieldConfig::light_filter)
     /// spreads `p` over (by default the cell holding `p`; the stochastic
-    /// box draws one `next_u64` of `rng`). Bad input is dropped and counted in
+    /// box draws one `next_u64` of `jitter` (a `rand_core` generator; or three numbers, see `spatial::Jitter`)). Bad input is dropped and counted in
     /// [`GuidingField::dropped_splats`] (`light`). Light splats add no spatial
     /// weight.
     #[inline]
-    pub fn splat_light<R: Rng + ?Sized>(
+    pub fn splat_light<J: Jitter + ?Sized>(
         &self,
         p: Vec3,
         light: LightId,
         value: f32,
-        rng: &mut R,
+        jitter: &mut J,
     ) -> SplatOutcome {
         let at = self.cells.locate_with_bounds(p);
-        let filter = (self.light_filter, || jitter_u64(rng));
+        let filter = (self.light_filter, || jitter_offset(jitter));
         self.record_light((p, at), light, value, filter)
     }
 

@@ -8,9 +8,9 @@ use crate::light_sampler::{LightId, LightSample, LightSampler};
 use crate::light_tree::LightHierarchy;
 use crate::math::Aabb;
 use crate::sd_tree::SdCell;
-use crate::spatial::{CellId, SpatialTree, jitter_u64};
+use crate::spatial::Jitter;
+use crate::spatial::{CellId, SpatialTree, jitter_offset};
 use glam::Vec3;
-use rand_core::Rng;
 
 /// A path vertex located in a [`GuidingField`]: the cell found by the one
 /// lookup ([`GuidingField::vertex`]), through which directional guiding,
@@ -109,26 +109,26 @@ impl<'f, H: LightHierarchy> FieldVertex<'f, H> {
 
     /// [`GuidingField::splat_radiance`] at this vertex's position.
     #[inline]
-    pub fn splat_radiance<R: Rng + ?Sized>(
+    pub fn splat_radiance<J: Jitter + ?Sized>(
         &self,
         dir: Vec3,
         radiance: f32,
         pdf: f32,
-        rng: &mut R,
+        jitter: &mut J,
     ) -> bool {
         self.field
-            .splat_radiance_from(self.p, Some(self.at), dir, radiance, pdf, rng)
+            .splat_radiance_from(self.p, Some(self.at), dir, radiance, pdf, jitter)
     }
 
     /// [`GuidingField::splat_light`] at this vertex's position.
     #[inline]
-    pub fn splat_light<R: Rng + ?Sized>(
+    pub fn splat_light<J: Jitter + ?Sized>(
         &self,
         light: LightId,
         value: f32,
-        rng: &mut R,
+        jitter: &mut J,
     ) -> SplatOutcome {
-        let filter = (self.field.light_filter, || jitter_u64(rng));
+        let filter = (self.field.light_filter, || jitter_offset(jitter));
         self.field
             .record_light((self.p, Some(self.at)), light, value, filter)
     }

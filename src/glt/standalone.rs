@@ -14,11 +14,11 @@ use crate::light_sampler::{LightId, LightSample, LightSampler};
 use crate::light_tree::LightHierarchy;
 use crate::math::pmf_to_f32;
 use crate::math::{Aabb, Counter};
+use crate::spatial::Jitter;
 use crate::spatial::{
-    BinaryTree, CellId, RefineOutcome, SpatialFilter, SpatialTree, jitter_u64, split_threshold,
+    BinaryTree, CellId, RefineOutcome, SpatialFilter, SpatialTree, jitter_offset, split_threshold,
 };
 use glam::Vec3;
-use rand_core::Rng;
 
 /// Parameters of a [`Glt`]: the cuts' and the spatial tree's.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -221,18 +221,20 @@ impl<H: LightHierarchy> Glt<H> {
     /// `p`. With [`SpatialFilter::StochasticBox`] `p` is first jittered
     /// uniformly inside a box the size of its cell centred on it (PPG's
     /// stochastic box, +-1/2 cell per axis; the paper's code uses +-1/4,
-    /// one `next_u64` of `rng` per call), which smooths cuts across cell
+    /// one `next_u64` of `jitter` (a `rand_core` generator; or three numbers, see `spatial::Jitter`) per call), which smooths cuts across cell
     /// borders but also carries light through walls. `&self`: any number
     /// of threads at once.
-    pub fn splat<R: Rng + ?Sized>(
+    pub fn splat<J: Jitter + ?Sized>(
         &self,
         p: Vec3,
         light: LightId,
         value: f32,
-        rng: &mut R,
+        jitter: &mut J,
     ) -> SplatOutcome {
         let at = self.spatial.locate_with_bounds(p);
-        self.splat_filtered(p, at, light, value, self.config.filter, || jitter_u64(rng))
+        self.splat_filtered(p, at, light, value, self.config.filter, || {
+            jitter_offset(jitter)
+        })
     }
 
     /// Like [`Glt::splat`] with [`SpatialFilter::Nearest`] whatever the
@@ -457,15 +459,15 @@ impl<'g, H: LightHierarchy> GltVertex<'g, H> {
     /// `value` for `light` (`Le * w_mis / pmf` for NEE, see
     /// [`CutRules::splat`]).
     #[inline]
-    pub fn splat_light<R: Rng + ?Sized>(
+    pub fn splat_light<J: Jitter + ?Sized>(
         &self,
         light: LightId,
         value: f32,
-        rng: &mut R,
+        jitter: &mut J,
     ) -> SplatOutcome {
         let g = self.glt;
         g.splat_filtered(self.p, Some(self.at), light, value, g.config.filter, || {
-            jitter_u64(rng)
+            jitter_offset(jitter)
         })
     }
 }

@@ -7,10 +7,10 @@ use crate::dropped::DropReason;
 use crate::math::Aabb;
 use crate::math::unit_direction;
 use crate::quadtree::DirectionalFilter;
+use crate::spatial::Jitter;
 use crate::spatial::SpatialFilter;
-use crate::spatial::{BinaryTree, CellId, SpatialTree, jitter_u32x3};
+use crate::spatial::{BinaryTree, CellId, SpatialTree, jitter_offset};
 use glam::Vec3;
-use rand_core::Rng;
 
 /// The located cell and the value to record, or why the splat is dropped
 /// (the first failing check, in this order: position, direction, radiance,
@@ -31,10 +31,10 @@ impl SdState {
     /// PPG's record into the cells of `tree` (see [`SdTree::splat`]); `at`
     /// is `tree.locate_with_bounds(p)`. Returns false, counting the reason,
     /// when the input is invalid. The stochastic box draws three
-    /// `next_u32` from `rng`.
+    /// numbers from `jitter`.
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    pub(crate) fn splat<C: AsRef<SdCell>, R: Rng + ?Sized>(
+    pub(crate) fn splat<C: AsRef<SdCell>, J: Jitter + ?Sized>(
         &self,
         tree: &BinaryTree<C>,
         p: Vec3,
@@ -43,7 +43,7 @@ impl SdState {
         radiance: f32,
         pdf: f32,
         filters: (SpatialFilter, DirectionalFilter),
-        rng: &mut R,
+        jitter: &mut J,
     ) -> bool {
         let (at, value) = match check(at, dir, radiance, pdf) {
             Ok(c) => c,
@@ -56,7 +56,7 @@ impl SdState {
             p,
             at,
             filters.0,
-            || jitter_u32x3(rng),
+            || jitter_offset(jitter),
             |cell, weight| {
                 tree.data(cell)
                     .as_ref()
@@ -99,17 +99,17 @@ impl SdState {
 impl SdTree {
     /// PPG's record with the configured filters: `radiance / pdf` into the
     /// quadtree of the cell at `p` along `dir`, statistical weight 1 (see
-    /// the [module docs](super#what-a-splat-records)). `rng` is only used
+    /// the [module docs](super#what-a-splat-records)). `jitter` is only used
     /// by [`SpatialFilter::StochasticBox`]. Returns false, counting the
     /// reason, when the input is invalid.
     #[inline]
-    pub fn splat<R: Rng + ?Sized>(
+    pub fn splat<J: Jitter + ?Sized>(
         &self,
         p: Vec3,
         dir: Vec3,
         radiance: f32,
         pdf: f32,
-        rng: &mut R,
+        jitter: &mut J,
     ) -> bool {
         let c = &self.state.config;
         self.splat_filtered(
@@ -119,13 +119,13 @@ impl SdTree {
             pdf,
             c.spatial_filter,
             c.directional_filter,
-            rng,
+            jitter,
         )
     }
 
     /// [`SdTree::splat`] with explicit filters.
     #[allow(clippy::too_many_arguments)]
-    pub fn splat_filtered<R: Rng + ?Sized>(
+    pub fn splat_filtered<J: Jitter + ?Sized>(
         &self,
         p: Vec3,
         dir: Vec3,
@@ -133,12 +133,12 @@ impl SdTree {
         pdf: f32,
         spatial: SpatialFilter,
         directional: DirectionalFilter,
-        rng: &mut R,
+        jitter: &mut J,
     ) -> bool {
         let at = self.tree.locate_with_bounds(p);
         let filters = (spatial, directional);
         self.state
-            .splat(&self.tree, p, at, dir, radiance, pdf, filters, rng)
+            .splat(&self.tree, p, at, dir, radiance, pdf, filters, jitter)
     }
 
     /// Reports one direction sample to the BSDF-fraction learner of the

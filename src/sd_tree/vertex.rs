@@ -3,9 +3,9 @@
 
 use super::{SdCell, SdTree};
 use crate::math::Aabb;
+use crate::spatial::Jitter;
 use crate::spatial::{CellId, SpatialTree};
 use glam::Vec3;
-use rand_core::Rng;
 
 /// A path vertex located in an [`SdTree`] ([`SdTree::vertex`]): directional
 /// guiding and both records at that point without looking the cell up
@@ -83,12 +83,12 @@ impl<'t> SdVertex<'t> {
     /// [`SdTree::splat`] at this vertex's position, with the configured
     /// filters.
     #[inline]
-    pub fn splat_radiance<R: Rng + ?Sized>(
+    pub fn splat_radiance<J: Jitter + ?Sized>(
         &self,
         dir: Vec3,
         radiance: f32,
         pdf: f32,
-        rng: &mut R,
+        jitter: &mut J,
     ) -> bool {
         let t = self.tree;
         let c = &t.state.config;
@@ -101,7 +101,7 @@ impl<'t> SdVertex<'t> {
             radiance,
             pdf,
             filters,
-            rng,
+            jitter,
         )
     }
 

@@ -8,7 +8,6 @@
 use super::{BinaryTree, CellId, SpatialTree};
 use crate::math::Aabb;
 use glam::Vec3;
-use rand_core::Rng;
 
 /// How a splat is spread over spatial cells.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -116,23 +115,6 @@ impl<T> BinaryTree<T> {
             }
         });
     }
-}
-
-/// A stochastic-box offset from three `next_u32` of `rng` (24 bits per
-/// axis), each coordinate in `[-1/2, 1/2)`: the SD-tree's draw.
-#[inline]
-pub(crate) fn jitter_u32x3<R: Rng + ?Sized>(rng: &mut R) -> Vec3 {
-    let mut unit = || (rng.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32);
-    Vec3::new(unit(), unit(), unit()) - 0.5
-}
-
-/// A stochastic-box offset from one `next_u64` of `rng` (21 bits per axis),
-/// each coordinate in `[-1/2, 1/2)`: the Guiding Light Tree's draw.
-#[inline]
-pub(crate) fn jitter_u64<R: Rng + ?Sized>(rng: &mut R) -> Vec3 {
-    let bits = rng.next_u64();
-    let unit = |k: u32| ((bits >> (k * 21)) & 0x1f_ffff) as f32 * (1.0 / 2_097_152.0) - 0.5;
-    Vec3::new(unit(0), unit(1), unit(2))
 }
 
 #[inline]

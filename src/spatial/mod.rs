@@ -38,6 +38,7 @@
 mod binary_tree;
 mod cell_id;
 mod filter;
+mod jitter;
 mod overlap;
 mod refine;
 mod root_cube;
@@ -47,7 +48,8 @@ mod tree_trait;
 pub use binary_tree::BinaryTree;
 pub use cell_id::{CellId, CellIds};
 pub use filter::SpatialFilter;
-pub(crate) use filter::{jitter_u32x3, jitter_u64};
+pub(crate) use jitter::jitter_offset;
+pub use jitter::{Jitter, JitterNumbers};
 pub use refine::RefineOutcome;
 pub use root_cube::SpatialError;
 pub use split_rule::split_threshold;
