@@ -85,6 +85,12 @@ fn estimate(
 ) -> f32 {
     let n = Vec3::Y;
     let ctx = ShadingContext::on_surface(p, n);
+    // Training: locate the point's cell once; it samples and records.
+    let vertex = glt.and_then(|g| g.vertex(p));
+    let sampler: &dyn LightSampler = match &vertex {
+        Some(v) => v,
+        None => sampler,
+    };
     let mut e = 0.0;
     // NEE: choose a light, then a direction towards it.
     if let Some(s) = sampler.sample(&ctx, uniform(rng)) {
@@ -98,9 +104,9 @@ fn estimate(
             let p_light = s.pmf * pdf_dir;
             let w = power_heuristic(p_light, cos / PI);
             e += light.radiance * cos * w / p_light;
-            if let Some(glt) = glt {
+            if let Some(v) = &vertex {
                 // Splat: Le * T * w_mis / (pdf_solid_angle * pmf).
-                glt.splat(p, s.light, light.radiance * w / p_light, rng);
+                v.splat_light(s.light, light.radiance * w / p_light, rng);
             }
         }
         // Occluded samples are not splatted (they would add nothing).
@@ -117,9 +123,9 @@ fn estimate(
             let id = LightId::Emitter(i as u32);
             let w = power_heuristic(pdf_bsdf, sampler.pmf(&ctx, id) * pdf_dir);
             e += light.radiance * dir.y * w / pdf_bsdf;
-            if let Some(glt) = glt {
+            if let Some(v) = &vertex {
                 // Splat: Le * w_mis / pdf_direction.
-                glt.splat(p, id, light.radiance * w / pdf_bsdf, rng);
+                v.splat_light(id, light.radiance * w / pdf_bsdf, rng);
             }
         }
     }
