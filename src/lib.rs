@@ -13,7 +13,15 @@
 //! 7. [`glt`]: the Guiding Light Tree, itself a [`LightSampler`];
 //! 8. [`field`]: one spatial tree holding a quadtree and a cut per cell, as
 //!    the paper uses them; [`schedule`]: PPG's iteration schedule and the
-//!    inverse-variance combination of the last iterations.
+//!    inverse-variance combination of the last iterations;
+//! 9. for the integrator: [`Strategy`] (a light sampler by name),
+//!    [`PathRecorder`] (a path's bookkeeping and its records) and [`mis`]
+//!    (the MIS heuristics).
+//!
+//! Each of [`sd_tree::SdTree`], [`glt::Glt`] and [`field::GuidingField`]
+//! locates a path vertex once with `vertex(p)` and answers and records
+//! through the handle; each owns (or shares, or borrows) its light tree;
+//! constructors validate their configuration ([`Error`]).
 //!
 //! ## Where things are
 //!
@@ -22,6 +30,8 @@
 //! | the GLT's sampling rule and pmf | `src/glt/sampling.rs` |
 //! | the light tree laid out for the GLT's walk | `src/glt/walk.rs` |
 //! | cut refinement (split / merge by sigma, `min_splats`) | `src/glt/refine.rs` |
+//! | the tables every cut reads (`CutRules`) | `src/glt/cut_rules.rs` |
+//! | a path's radiance records | `src/path_recorder.rs` |
 //! | light-tree build heuristics | `src/light_tree/build.rs` |
 //! | the importance of a light cluster | `src/light_sampler/importance.rs` |
 //! | the same, from decoded nodes in `f32` (the GLT's importance rules) | `src/light_sampler/importance_table.rs` |
@@ -36,8 +46,9 @@
 //!   takes `&mut self` between iterations. [`math::Accumulation::Deterministic`]
 //!   makes learned state bit-identical whatever the thread count.
 //! - Bad input never panics: builds return typed errors, records drop and
-//!   count it.
-
+//!   count it ([`DroppedSplats`]); invalid configuration is an error, never
+//!   a silent clamp.
+//!
 //! ## Features
 //!
 //! - `std` (default): use the standard library. Without it the crate is
