@@ -22,6 +22,26 @@
 //! - [`InverseVarianceCombiner`] keeps the last (up to) four iterations and
 //!   blends them with weights `1 / variance`, normalised to sum to 1.
 //!
+//! ## Renderers that render in one pass
+//!
+//! A progressive renderer (one image, refined sample round by sample
+//! round, no separate training pass) follows the same plan with its own
+//! rounds: render round after round into the current iteration's
+//! [`PassStats`], recording into the guiding structure as it goes; when the
+//! iteration's passes are done, call `refine()` (the one `&mut` step,
+//! between rounds, while no thread records), hand the iteration's image to
+//! the combiner and start the next iteration. Every round's image is an
+//! unbiased estimate whatever the guide learned, so the combination of the
+//! last iterations is the image at any moment. A tile-based renderer does
+//! the same with "all tiles of one round" as its pass. Records of the last
+//! iteration are not needed (nothing refines after it): stop recording
+//! there to save their cost.
+//!
+//! Zero-valued records (an occluded shadow ray, a path that found no light)
+//! are valid observations everywhere in the crate: they add nothing to the
+//! sums but count as samples for the spatial split rules, so record them as
+//! they come (the GLT's splats return `SplatOutcome::Zero` for them).
+//!
 //! One weight per iteration (from the variance averaged over the image), not
 //! per pixel: per-pixel weights computed from the same few passes correlate
 //! with the pixel values (a pixel whose passes happened to miss a bright
