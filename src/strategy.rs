@@ -79,41 +79,43 @@ impl Strategy {
             _ => None,
         }
     }
+}
 
-    /// The sampler inside, as a trait object.
-    #[inline]
-    fn sampler(&self) -> &dyn LightSampler {
-        match self {
-            Self::Uniform(s) => s,
-            Self::Power(s) => s,
-            Self::Importance(s) => s,
-            Self::Glt(s) => &**s,
+/// Calls `$call` on the sampler inside (a `match`, not a virtual call: this
+/// runs per sample).
+macro_rules! inner {
+    ($self:ident, $s:ident => $call:expr) => {
+        match $self {
+            Strategy::Uniform($s) => $call,
+            Strategy::Power($s) => $call,
+            Strategy::Importance($s) => $call,
+            Strategy::Glt($s) => $call,
         }
-    }
+    };
 }
 
 impl LightSampler for Strategy {
     #[inline]
     fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
-        self.sampler().sample(ctx, u)
+        inner!(self, s => s.sample(ctx, u))
     }
 
     #[inline]
     fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        self.sampler().pmf(ctx, light)
+        inner!(self, s => s.pmf(ctx, light))
     }
 
     fn is_empty(&self) -> bool {
-        self.sampler().is_empty()
+        inner!(self, s => s.is_empty())
     }
 
     #[inline]
     fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
-        self.sampler().sample_exact(ctx, u)
+        inner!(self, s => s.sample_exact(ctx, u))
     }
 
     #[inline]
     fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
-        self.sampler().pmf_exact(ctx, light)
+        inner!(self, s => s.pmf_exact(ctx, light))
     }
 }

@@ -51,9 +51,9 @@ impl<H: LightHierarchy> GuidingField<H> {
     /// is) into the cut of the cell(s) that
     /// [`FieldConfig::light_filter`](super::FieldConfig::light_filter)
     /// spreads `p` over (by default the cell holding `p`; the stochastic
-    /// box draws one `next_u64` of `jitter` (a `rand_core` generator; or three numbers, see `spatial::Jitter`)). Bad input is dropped and counted in
-    /// [`GuidingField::dropped_splats`] (`light`). Light splats add no spatial
-    /// weight.
+    /// box takes three numbers from `jitter`, see [`Jitter`]). Bad input
+    /// is dropped and counted in [`GuidingField::dropped_splats`]
+    /// (`light`). Light splats add no spatial weight.
     #[inline]
     pub fn splat_light<J: Jitter + ?Sized>(
         &self,

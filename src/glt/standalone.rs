@@ -220,10 +220,10 @@ impl<H: LightHierarchy> Glt<H> {
     /// [`GltConfig::filter`] spreads `p` over: by default the cell holding
     /// `p`. With [`SpatialFilter::StochasticBox`] `p` is first jittered
     /// uniformly inside a box the size of its cell centred on it (PPG's
-    /// stochastic box, +-1/2 cell per axis; the paper's code uses +-1/4,
-    /// one `next_u64` of `jitter` (a `rand_core` generator; or three numbers, see `spatial::Jitter`) per call), which smooths cuts across cell
-    /// borders but also carries light through walls. `&self`: any number
-    /// of threads at once.
+    /// stochastic box, +-1/2 cell per axis, the paper's code uses +-1/4;
+    /// three numbers from `jitter`, see [`Jitter`]), which smooths cuts
+    /// across cell borders but also carries light through walls. `&self`:
+    /// any number of threads at once.
     pub fn splat<J: Jitter + ?Sized>(
         &self,
         p: Vec3,

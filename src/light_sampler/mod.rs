@@ -94,56 +94,37 @@ pub trait LightSampler {
     }
 }
 
-impl<S: LightSampler + ?Sized> LightSampler for &S {
-    #[inline]
-    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
-        (**self).sample(ctx, u)
-    }
+/// A borrowed or boxed sampler is a sampler (every method forwarded,
+/// the exact variants included).
+macro_rules! forward_sampler {
+    ($($ptr:ty),*) => {$(
+        impl<S: LightSampler + ?Sized> LightSampler for $ptr {
+            #[inline]
+            fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+                (**self).sample(ctx, u)
+            }
 
-    #[inline]
-    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        (**self).pmf(ctx, light)
-    }
+            #[inline]
+            fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+                (**self).pmf(ctx, light)
+            }
 
-    #[inline]
-    fn is_empty(&self) -> bool {
-        (**self).is_empty()
-    }
+            #[inline]
+            fn is_empty(&self) -> bool {
+                (**self).is_empty()
+            }
 
-    #[inline]
-    fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
-        (**self).sample_exact(ctx, u)
-    }
+            #[inline]
+            fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
+                (**self).sample_exact(ctx, u)
+            }
 
-    #[inline]
-    fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
-        (**self).pmf_exact(ctx, light)
-    }
+            #[inline]
+            fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
+                (**self).pmf_exact(ctx, light)
+            }
+        }
+    )*};
 }
 
-impl<S: LightSampler + ?Sized> LightSampler for alloc::boxed::Box<S> {
-    #[inline]
-    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
-        (**self).sample(ctx, u)
-    }
-
-    #[inline]
-    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        (**self).pmf(ctx, light)
-    }
-
-    #[inline]
-    fn is_empty(&self) -> bool {
-        (**self).is_empty()
-    }
-
-    #[inline]
-    fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
-        (**self).sample_exact(ctx, u)
-    }
-
-    #[inline]
-    fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
-        (**self).pmf_exact(ctx, light)
-    }
-}
+forward_sampler!(&S, alloc::boxed::Box<S>);
