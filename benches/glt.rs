@@ -153,7 +153,7 @@ fn bench_sampling(c: &mut Criterion) {
         });
         let depth = |light: LightId| match light {
             LightId::Emitter(e) => tree.path(e).map_or(0, |p| p.depth()),
-            LightId::Environment => 0,
+            LightId::Unbounded(_) => 0,
         };
         let mean_depth = |lights: &[LightId]| {
             lights.iter().map(|&l| depth(l)).sum::<usize>() as f64 / lights.len().max(1) as f64

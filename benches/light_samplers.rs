@@ -9,7 +9,8 @@ use criterion::{
 };
 use glam::Vec3;
 use guiding::light_sampler::{
-    ImportanceTreeSampler, PowerSampler, PowerTreeSampler, UniformSampler, WithEnvironment,
+    ImportanceTreeSampler, PowerSampler, PowerTreeSampler, UnboundedLights, UniformSampler,
+    WithUnbounded,
 };
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::{Aabb, LightCone};
@@ -128,8 +129,12 @@ fn light_samplers(c: &mut Criterion) {
         );
         bench_sampler(
             &mut group,
-            "env+importance_tree",
-            &WithEnvironment::new(ImportanceTreeSampler::new(&tree), 0.1),
+            "unbounded+importance_tree",
+            &WithUnbounded::new(
+                ImportanceTreeSampler::new(&tree),
+                UnboundedLights::new(2, 0.1).unwrap(),
+            )
+            .unwrap(),
             &queries,
         );
         group.finish();

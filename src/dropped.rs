@@ -23,8 +23,8 @@ pub(crate) enum DropReason {
     /// `radiance / pdf` overflowed `f32`.
     Overflow,
     /// A light splat: a non-finite position, a negative or non-finite
-    /// value, an emitter out of range or without power, or the environment
-    /// where none is configured.
+    /// value, an emitter out of range or without power, or an unbounded
+    /// light beyond the configured count.
     Light,
 }
 
@@ -46,8 +46,8 @@ pub struct DroppedSplats {
     pub overflow: u64,
     /// Light splats (of the GLT or the field's cuts), every reason
     /// together: a non-finite position, a negative or non-finite value, an
-    /// emitter out of range or without power, or the environment where none
-    /// is configured.
+    /// emitter out of range or without power, or an unbounded light beyond
+    /// the configured count.
     pub light: u64,
 }
 

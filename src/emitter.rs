@@ -7,9 +7,9 @@ use glam::Vec3;
 /// The lights of a scene as the crate sees them: the renderer implements this
 /// for its own light list (or uses `[Emitter]`).
 ///
-/// Emitters are identified by their index `0..len()`. An environment
-/// (infinite) light is not an emitter: the samplers handle it beside the
-/// tree.
+/// Emitters are identified by their index `0..len()`. Unbounded lights
+/// (distant and infinite) are not emitters: the samplers handle them beside
+/// the tree ([`crate::UnboundedLights`]).
 pub trait Emitters {
     /// How many emitters.
     fn len(&self) -> usize;

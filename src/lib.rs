@@ -89,7 +89,7 @@ pub use emitter::{Emitter, Emitters, ShadingContext};
 pub use error::{ConfigError, Error};
 pub use light_sampler::{
     ImportanceTreeSampler, LightId, LightSample, LightSampler, PowerSampler, PowerTreeSampler,
-    UniformSampler, WithEnvironment,
+    UnboundedLights, UniformSampler, WithUnbounded,
 };
 pub use light_tree::{LightHierarchy, LightTree};
 pub use path_recorder::PathRecorder;

@@ -5,7 +5,8 @@ use crate::emitter::{Emitters, ShadingContext};
 use crate::error::Error;
 use crate::glt::{Glt, GltConfig};
 use crate::light_sampler::{
-    ImportanceTreeSampler, LightId, LightSample, LightSampler, PowerSampler, UniformSampler,
+    ImportanceTreeSampler, LightId, LightSample, LightSampler, PowerSampler, UnboundedLights,
+    UniformSampler, WithUnbounded,
 };
 use crate::light_tree::{BuildHeuristic, LightTree};
 use crate::math::Aabb;
@@ -14,26 +15,30 @@ use crate::math::Aabb;
 /// `"importance"` (the light BVH of Estevez-Kulla and pbrt-v4) or `"glt"`
 /// (the Guiding Light Tree, with its training side through
 /// [`Strategy::glt_mut`]). It owns its light tree, is `Send + Sync`, and
-/// samples exactly as the sampler it wraps.
+/// samples exactly as the sampler it wraps, the scene's unbounded lights
+/// (distant, infinite) beside the emitters.
 ///
 /// ```
-/// use guiding::{glam::Vec3, math::Aabb, Emitter, LightSampler, ShadingContext, Strategy};
+/// use guiding::{glam::Vec3, math::Aabb, Emitter, LightId, LightSampler};
+/// use guiding::{ShadingContext, Strategy, UnboundedLights};
 /// let lights = [Emitter::point(Vec3::Y, 1.0), Emitter::point(Vec3::X, 3.0)];
 /// let scene = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
-/// let s = Strategy::new("power", &lights[..], scene)?;
+/// let sun = UnboundedLights::new(1, 0.2)?;
+/// let s = Strategy::new("power", &lights[..], sun, scene)?;
 /// let ctx = ShadingContext::at(Vec3::ZERO);
-/// assert_eq!(s.pmf(&ctx, guiding::LightId::Emitter(1)), 0.75);
-/// assert!(Strategy::new("bvh-2000", &lights[..], scene).is_err());
+/// assert_eq!(s.pmf(&ctx, LightId::Emitter(1)), 0.6);
+/// assert_eq!(s.pmf(&ctx, LightId::Unbounded(0)), 0.2);
+/// assert!(Strategy::new("bvh-2000", &lights[..], sun, scene).is_err());
 /// # Ok::<(), guiding::Error>(())
 /// ```
 #[derive(Debug)]
 pub enum Strategy {
     /// Every emitter equally.
-    Uniform(UniformSampler),
+    Uniform(WithUnbounded<UniformSampler>),
     /// In proportion to power.
-    Power(PowerSampler),
+    Power(WithUnbounded<PowerSampler>),
     /// Descending the light tree by importance at the shading point.
-    Importance(ImportanceTreeSampler<LightTree>),
+    Importance(WithUnbounded<ImportanceTreeSampler<LightTree>>),
     /// The Guiding Light Tree (learns; refine it between iterations).
     Glt(alloc::boxed::Box<Glt<LightTree>>),
 }
@@ -42,21 +47,31 @@ impl Strategy {
     /// The names [`Strategy::new`] accepts.
     pub const NAMES: [&'static str; 4] = ["uniform", "power", "importance", "glt"];
 
-    /// The strategy called `name` over `emitters`; `scene` bounds the
-    /// shading points (used by `"glt"`, with [`GltConfig::default`]).
-    /// Errors for an unknown name and for emitters a light tree cannot be
-    /// built from (`"importance"`, `"glt"`).
-    pub fn new<E: Emitters + ?Sized>(name: &str, emitters: &E, scene: Aabb) -> Result<Self, Error> {
+    /// The strategy called `name` over `emitters` and the scene's
+    /// `unbounded` lights ([`UnboundedLights::NONE`] for none); `scene`
+    /// bounds the shading points (used by `"glt"`, with
+    /// [`GltConfig::default`] and `unbounded` as its cuts' prior). Errors
+    /// for an unknown name, an invalid `unbounded`, and emitters a light
+    /// tree cannot be built from (`"importance"`, `"glt"`).
+    pub fn new<E: Emitters + ?Sized>(
+        name: &str,
+        emitters: &E,
+        unbounded: UnboundedLights,
+        scene: Aabb,
+    ) -> Result<Self, Error> {
         let tree = || LightTree::build(emitters, BuildHeuristic::default()).map_err(Error::Build);
+        let u = unbounded;
         Ok(match name {
-            "uniform" => Self::Uniform(UniformSampler::new(emitters.len())),
-            "power" => Self::Power(PowerSampler::new(emitters)),
-            "importance" => Self::Importance(ImportanceTreeSampler::new(tree()?)),
-            "glt" => Self::Glt(alloc::boxed::Box::new(Glt::new(
-                tree()?,
-                scene,
-                GltConfig::default(),
-            )?)),
+            "uniform" => Self::Uniform(WithUnbounded::new(UniformSampler::new(emitters.len()), u)?),
+            "power" => Self::Power(WithUnbounded::new(PowerSampler::new(emitters), u)?),
+            "importance" => {
+                Self::Importance(WithUnbounded::new(ImportanceTreeSampler::new(tree()?), u)?)
+            }
+            "glt" => {
+                let mut config = GltConfig::default();
+                config.cut.unbounded = unbounded;
+                Self::Glt(alloc::boxed::Box::new(Glt::new(tree()?, scene, config)?))
+            }
             _ => return Err(Error::UnknownStrategy),
         })
     }

@@ -9,7 +9,7 @@ use guiding::glt::{CutConfig, CutRules, Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::quadtree::QuadtreeConfig;
 use guiding::sd_tree::{SdTree, SdTreeConfig};
-use guiding::{ConfigError, Error, LightTree};
+use guiding::{ConfigError, Error, LightTree, UnboundedLights};
 
 fn tree() -> LightTree {
     LightTree::build(&two_rooms(), BuildHeuristic::Sarh).unwrap()
@@ -73,24 +73,24 @@ fn cut_config_fields() {
     for alpha in [-1e-9, 1.5, f64::NAN, f64::NEG_INFINITY] {
         check_cut(CutConfig { alpha, ..d }, Some("CutConfig::alpha"));
     }
-    for q in [0.0, 0.5, 0.999] {
-        check_cut(
-            CutConfig {
-                environment: Some(q),
-                ..d
-            },
-            None,
-        );
+    let unbounded = |count, probability| CutConfig {
+        unbounded: UnboundedLights { count, probability },
+        ..d
+    };
+    for (count, q) in [(0, 0.0), (1, 1e-9), (2, 0.5), (3, 0.999)] {
+        check_cut(unbounded(count, q), None);
     }
-    // At 1 no emitter could ever be sampled (was clamped silently).
-    for q in [1.0, 2.0, -0.1, f64::NAN] {
-        check_cut(
-            CutConfig {
-                environment: Some(q),
-                ..d
-            },
-            Some("CutConfig::environment"),
-        );
+    // At 1 no emitter could ever be sampled (was clamped silently); at 0 a
+    // sun would never be; a share for no light is a mistake.
+    for (count, q) in [
+        (1, 1.0),
+        (1, 2.0),
+        (2, -0.1),
+        (1, f64::NAN),
+        (2, 0.0),
+        (0, 0.3),
+    ] {
+        check_cut(unbounded(count, q), Some("UnboundedLights::probability"));
     }
 }
 

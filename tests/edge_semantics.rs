@@ -12,7 +12,7 @@ use guiding::glt::{CutConfig, CutRules, Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::{
     ImportanceTreeSampler, LightId, LightSampler, LightTree, PowerSampler, PowerTreeSampler,
-    ShadingContext, UniformSampler, WithEnvironment,
+    ShadingContext, UnboundedLights, UniformSampler, WithUnbounded,
 };
 
 /// The largest `f32` below one.
@@ -49,7 +49,7 @@ fn check(name: &str, s: &dyn LightSampler, n: u32) {
                 for e in 0..n {
                     assert_eq!(s.pmf(&ctx, LightId::Emitter(e)), 0.0, "{name}: {bad}");
                 }
-                assert_eq!(s.pmf(&ctx, LightId::Environment), 0.0, "{name}: {bad}");
+                assert_eq!(s.pmf(&ctx, LightId::Unbounded(0)), 0.0, "{name}: {bad}");
             }
         }
         // The exact variants: one place (the trait), the same contract.
@@ -80,7 +80,11 @@ fn every_sampler_has_the_same_edges() {
     check("importance tree", &ImportanceTreeSampler::new(&tree), n);
     check(
         "with environment",
-        &WithEnvironment::new(PowerSampler::new(&lights), 0.25),
+        &WithUnbounded::new(
+            PowerSampler::new(&lights),
+            UnboundedLights::new(2, 0.25).unwrap(),
+        )
+        .unwrap(),
         n,
     );
     let mut glt = Glt::new(&tree, scene(), GltConfig::default()).unwrap();

@@ -12,7 +12,9 @@ use guiding::quadtree::UNIFORM_PDF;
 use guiding::sd_tree::{SdCell, SdTree, SdTreeConfig};
 use guiding::spatial::SpatialFilter;
 use guiding::spatial::{RefineOutcome, SpatialTree};
-use guiding::{Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext};
+use guiding::{
+    Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext, UnboundedLights,
+};
 use proptest::prelude::*;
 use rand_pcg::Pcg32;
 use rand_pcg::rand_core::{Rng, SeedableRng};
@@ -61,7 +63,7 @@ fn light_dir(lights: &[Emitter], p: Vec3, rng: &mut Rand) -> Vec3 {
 fn emitter(light: LightId) -> u32 {
     match light {
         LightId::Emitter(e) => e,
-        LightId::Environment => panic!("no environment in these scenes"),
+        LightId::Unbounded(_) => panic!("no unbounded lights in these scenes"),
     }
 }
 
@@ -328,7 +330,8 @@ proptest! {
         seed in any::<u64>(),
         n in 1usize..40,
         dark in 0usize..3,
-        env in proptest::option::of(0.0f64..0.6),
+        unbounded in 0u32..3,
+        share in 1e-6f64..0.6,
         importance in any::<bool>(),
         iterations in 0usize..4,
     ) {
@@ -338,7 +341,10 @@ proptest! {
         let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
         let config = FieldConfig {
             cut: CutConfig {
-                environment: env,
+                unbounded: match unbounded {
+                    0 => UnboundedLights::NONE,
+                    k => UnboundedLights::new(k, share).unwrap(),
+                },
                 below_cut: if importance { BelowCut::Importance } else { BelowCut::Power },
                 ..CutConfig::default()
             },
@@ -369,7 +375,7 @@ proptest! {
             let mut total: f64 = (0..n as u32)
                 .map(|e| v.pmf_exact(&ctx, LightId::Emitter(e)))
                 .sum();
-            total += v.pmf_exact(&ctx, LightId::Environment);
+            total += (0..unbounded).map(|i| v.pmf_exact(&ctx, LightId::Unbounded(i))).sum::<f64>();
             prop_assert!((total - 1.0).abs() < 1e-5, "pmf sums to {}", total);
             for _ in 0..20 {
                 let u = rng.f();
@@ -590,7 +596,7 @@ fn bad_input_is_dropped_and_counted() {
         (nan, LightId::Emitter(1), 1.0),
         (p, LightId::Emitter(80), 1.0),
         (p, LightId::Emitter(5), 1.0),
-        (p, LightId::Environment, 1.0),
+        (p, LightId::Unbounded(0), 1.0),
     ];
     for (i, &(q, l, x)) in lbad.iter().enumerate() {
         assert_eq!(
@@ -786,9 +792,9 @@ fn memory_report_adds_up_and_compares_cuts_with_quadtrees() {
         .sum();
     assert_eq!(m.cuts.nodes, nodes);
     assert_eq!(m.cuts.node_bytes, 12 * nodes);
-    // One sum per slot plus the environment's, and the default modulation's
-    // 7 anchor sums, per cell.
-    assert_eq!(m.cuts.sum_bytes, 8 * (2 * nodes + 8 * m.sd.cells));
+    // One sum per slot (no unbounded light here), and the default
+    // modulation's 7 anchor sums, per cell.
+    assert_eq!(m.cuts.sum_bytes, 8 * (2 * nodes + 7 * m.sd.cells));
     // Split table 4 B per node; walk table one 16-B pair per inner node +
     // root; the default importance rules' table one 64-B pair beside it.
     assert_eq!(

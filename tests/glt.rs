@@ -11,7 +11,9 @@ use guiding::glt::{
 };
 use guiding::light_tree::{BuildHeuristic, EmitterPath, NodeBounds};
 use guiding::math::{Aabb, Accumulation, LightCone, Side};
-use guiding::{Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext};
+use guiding::{
+    Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext, UnboundedLights,
+};
 use proptest::prelude::*;
 
 mod common;
@@ -63,13 +65,20 @@ fn assert_valid_cut<H: LightHierarchy + ?Sized>(tree: &H, cut: &GuidingCut) {
     }
 }
 
-/// Sum of the exact pmf over every emitter and the environment.
+/// Sum of the exact pmf over every emitter and unbounded light.
 fn pmf_total<H: LightHierarchy + ?Sized>(
     guide: &CutRules<&H>,
     cut: &GuidingCut,
     ctx: &ShadingContext,
 ) -> f64 {
-    let mut total = guide.pmf_exact(cut, ctx, LightId::Environment);
+    let unbounded = guide.config().unbounded.count;
+    let mut total: f64 = (0..unbounded)
+        .map(|i| guide.pmf_exact(cut, ctx, LightId::Unbounded(i)))
+        .sum();
+    assert_eq!(
+        guide.pmf_exact(cut, ctx, LightId::Unbounded(unbounded)),
+        0.0
+    );
     for e in 0..guide.light_tree().emitter_count() as u32 {
         let p = guide.pmf_exact(cut, ctx, LightId::Emitter(e));
         assert!(p.is_finite() && p >= 0.0, "pmf {p} for {e}");
@@ -82,8 +91,8 @@ fn pmf_total<H: LightHierarchy + ?Sized>(
 fn expected_total<H: LightHierarchy + ?Sized>(guide: &CutRules<&H>) -> f64 {
     let tree = guide.light_tree();
     let emitters = tree.root().is_some_and(|r| tree.power(r) > 0.0);
-    let env = guide.config().environment.is_some();
-    if emitters || env { 1.0 } else { 0.0 }
+    let unbounded = guide.config().unbounded.count > 0;
+    if emitters || unbounded { 1.0 } else { 0.0 }
 }
 
 /// `sample`'s pmf equals `pmf()` bit for bit, in `f64` and in `f32`, and a
@@ -220,10 +229,11 @@ fn config_strategy() -> impl Strategy<Value = CutConfig> {
         prop_oneof![Just(0.0), Just(0.1), Just(0.5), Just(1.0)],
         0usize..4,
         prop_oneof![
-            Just(None),
-            Just(Some(0.0)),
-            Just(Some(0.2)),
-            Just(Some(0.99))
+            Just(UnboundedLights::NONE),
+            Just(UnboundedLights::new(1, 1e-9).unwrap()),
+            Just(UnboundedLights::new(1, 0.2).unwrap()),
+            Just(UnboundedLights::new(2, 0.2).unwrap()),
+            Just(UnboundedLights::new(3, 0.99).unwrap())
         ],
         any::<bool>(),
         prop_oneof![Just(0u32), Just(1), Just(64)],
@@ -231,7 +241,7 @@ fn config_strategy() -> impl Strategy<Value = CutConfig> {
         any::<bool>(),
     )
         .prop_map(
-            |(sigma, alpha, variant, environment, exact, min_splats, modulate, prior_imp)| {
+            |(sigma, alpha, variant, unbounded, exact, min_splats, modulate, prior_imp)| {
                 let (below_cut, split_prior) = ALL_CONFIGS[variant];
                 CutConfig {
                     sigma,
@@ -243,7 +253,7 @@ fn config_strategy() -> impl Strategy<Value = CutConfig> {
                         Modulation::None
                     },
                     split_prior,
-                    environment,
+                    unbounded,
                     accumulation: if exact {
                         Accumulation::Deterministic
                     } else {
@@ -293,16 +303,17 @@ proptest! {
         assert_valid_cut(&tree, &cut);
         for round in &rounds {
             for (id, value) in round {
-                // Mostly real emitters, some out of range, some environment.
+                // Mostly real emitters, some out of range, some unbounded
+                // (some of those beyond the configured count).
                 let light = match id % 10 {
-                    0 => LightId::Environment,
+                    0 => LightId::Unbounded(id % 4),
                     1 => LightId::Emitter(n + id),
                     _ => LightId::Emitter(id % n),
                 };
                 let outcome = guide.splat_from(&cut, rng.point(3.0), light, value.get());
                 let dark = match light {
                     LightId::Emitter(e) => e >= n || lights[e as usize].power == 0.0,
-                    LightId::Environment => config.environment.is_none(),
+                    LightId::Unbounded(i) => i >= config.unbounded.count,
                 };
                 if value.is_bad() || dark {
                     prop_assert_eq!(outcome, SplatOutcome::Dropped);
@@ -830,7 +841,7 @@ fn sums_across_sixty_decades() {
     for accumulation in [Accumulation::Fast, Accumulation::Deterministic] {
         let config = CutConfig {
             accumulation,
-            environment: Some(0.1),
+            unbounded: UnboundedLights::new(2, 0.1).unwrap(),
             ..CutConfig::default()
         };
         let guide = CutRules::new(&tree, config).unwrap();
@@ -841,7 +852,8 @@ fn sums_across_sixty_decades() {
                 let v = 10f32.powi(decade as i32 - 30);
                 guide.splat(&cut, LightId::Emitter(e), v);
             }
-            guide.splat(&cut, LightId::Environment, 1.0e-30);
+            guide.splat(&cut, LightId::Unbounded(0), 1.0e-30);
+            guide.splat(&cut, LightId::Unbounded(1), 1.0e30);
             guide.refine(&mut cut);
             assert_valid_cut(&tree, &cut);
             for _ in 0..3 {
@@ -858,8 +870,8 @@ fn sums_across_sixty_decades() {
     }
 }
 
-/// Empty, single-light and two-light scenes, with and without an
-/// environment light and the mixture.
+/// Empty, single-light and two-light scenes, with and without unbounded
+/// lights (a sun and a sky) and the mixture.
 #[test]
 fn tiny_scenes() {
     let one = vec![Emitter::point(Vec3::ONE, 2.0)];
@@ -875,11 +887,14 @@ fn tiny_scenes() {
     let mut rng = Rand::new(1);
     for lights in [&none, &one, &two, &dark] {
         let tree = LightTree::build(lights, BuildHeuristic::Sarh).unwrap();
-        for environment in [None, Some(0.25)] {
+        for unbounded in [
+            UnboundedLights::NONE,
+            UnboundedLights::new(2, 0.25).unwrap(),
+        ] {
             for alpha in [0.0, 0.1] {
                 let config = CutConfig {
                     alpha,
-                    environment,
+                    unbounded,
                     ..CutConfig::default()
                 };
                 let guide = CutRules::new(&tree, config).unwrap();
@@ -894,7 +909,10 @@ fn tiny_scenes() {
                         guide.splat(&cut, LightId::Emitter(e), 1.0 + e as f32);
                     }
                     if round == 1 {
-                        guide.splat(&cut, LightId::Environment, 3.0);
+                        guide.splat(&cut, LightId::Unbounded(0), 3.0);
+                    }
+                    if round == 2 {
+                        guide.splat(&cut, LightId::Unbounded(1), 0.5);
                     }
                     guide.refine(&mut cut);
                 }
@@ -1049,7 +1067,7 @@ fn threads_equal_serial() {
     let stream: Vec<(LightId, f32)> = (0..40_000)
         .map(|i| {
             let light = if i % 97 == 0 {
-                LightId::Environment
+                LightId::Unbounded(i % 2)
             } else {
                 LightId::Emitter(rng.below(400) % (rng.below(400) + 1))
             };
@@ -1059,7 +1077,7 @@ fn threads_equal_serial() {
     for accumulation in [Accumulation::Deterministic, Accumulation::Fast] {
         let config = CutConfig {
             accumulation,
-            environment: Some(0.05),
+            unbounded: UnboundedLights::new(2, 0.05).unwrap(),
             sigma: 0.002,
             ..CutConfig::default()
         };
@@ -1092,10 +1110,13 @@ fn threads_equal_serial() {
                     let bytes_a: &[u8] = bytemuck::cast_slice(a);
                     let bytes_b: &[u8] = bytemuck::cast_slice(b);
                     assert_eq!(bytes_a, bytes_b);
-                    assert_eq!(
-                        serial.env_fraction().to_bits(),
-                        parallel.env_fraction().to_bits()
-                    );
+                    let bits = |c: &GuidingCut| {
+                        c.unbounded_fractions()
+                            .iter()
+                            .map(|f| f.to_bits())
+                            .collect::<Vec<_>>()
+                    };
+                    assert_eq!(bits(&serial), bits(&parallel));
                 }
                 Accumulation::Fast => {
                     assert_eq!(a.len(), b.len());
@@ -1132,9 +1153,9 @@ fn cut_node_is_twelve_bytes() {
         let m = cut.memory();
         assert_eq!(m.nodes, cut.nodes().len());
         assert_eq!(m.node_bytes, 12 * m.nodes);
-        // One sum per slot and the environment's, plus the default
+        // One sum per slot (no unbounded light here), plus the default
         // modulation's 7 anchor sums.
-        assert_eq!(m.sum_bytes, per_sum * (2 * m.nodes + 1 + 7));
+        assert_eq!(m.sum_bytes, per_sum * (2 * m.nodes + 7));
         assert_eq!(cut.heap_bytes(), m.node_bytes + m.sum_bytes);
     }
 }

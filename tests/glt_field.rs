@@ -9,7 +9,9 @@ use guiding::light_tree::BuildHeuristic;
 use guiding::math::Accumulation;
 use guiding::spatial::SpatialFilter;
 use guiding::spatial::SpatialTree;
-use guiding::{Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext};
+use guiding::{
+    Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext, UnboundedLights,
+};
 
 mod common;
 use common::{Rand, scene, two_rooms, value};
@@ -84,7 +86,7 @@ fn learns_per_region_and_keeps_the_contract() {
             .map(|e| glt.pmf_exact(&ctx, LightId::Emitter(e)))
             .sum();
         assert!((total - 1.0).abs() < 1e-5, "{total}");
-        assert_eq!(glt.pmf(&ctx, LightId::Environment), 0.0);
+        assert_eq!(glt.pmf(&ctx, LightId::Unbounded(0)), 0.0);
         for _ in 0..50 {
             let s = glt.sample(&ctx, rng.f()).unwrap();
             assert_eq!(s.pmf.to_bits(), glt.pmf(&ctx, s.light).to_bits());
@@ -201,7 +203,7 @@ fn jitter_spreads_over_neighbouring_cells() {
 
 /// Bad input is dropped and counted, never recorded: non-finite or
 /// negative values, non-finite positions, emitters out of range or with
-/// zero power, the environment when none is configured.
+/// zero power, unbounded lights when none is configured.
 #[test]
 fn bad_splats_are_counted() {
     let mut lights = two_rooms();
@@ -218,7 +220,7 @@ fn bad_splats_are_counted() {
         (p, LightId::Emitter(80), 1.0),
         (p, LightId::Emitter(u32::MAX), 1.0),
         (p, LightId::Emitter(5), 1.0),
-        (p, LightId::Environment, 1.0),
+        (p, LightId::Unbounded(0), 1.0),
     ];
     for (i, &(q, light, v)) in bad.iter().enumerate() {
         assert_eq!(glt.splat(q, light, v, &mut rng.0), SplatOutcome::Dropped);
@@ -246,45 +248,75 @@ fn bad_splats_are_counted() {
     assert_eq!(glt.pmf(&nan, LightId::Emitter(0)), 0.0);
 }
 
-/// The environment light: learned per cell beside the cut, with the prior
-/// floor; the pmf still sums to one.
+/// A sun and a sky (two unbounded lights): each one's share is learned per
+/// cell beside the cut, each keeps its prior floor `alpha q / 2`, the pmf
+/// still sums to one and sampling follows it.
 #[test]
-fn environment_fraction_is_learned() {
+fn unbounded_shares_are_learned() {
     let lights = two_rooms();
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
     let config = GltConfig {
         cut: CutConfig {
-            environment: Some(0.3),
+            unbounded: UnboundedLights::new(2, 0.3).unwrap(),
             ..CutConfig::default()
         },
         ..GltConfig::default()
     };
     let mut glt = Glt::new(&tree, scene(), config).unwrap();
     let ctx = ShadingContext::at(Vec3::ZERO);
-    assert!((glt.pmf_exact(&ctx, LightId::Environment) - 0.3).abs() < 1e-7);
+    let (sky, sun) = (LightId::Unbounded(0), LightId::Unbounded(1));
+    for light in [sky, sun] {
+        assert!((glt.pmf_exact(&ctx, light) - 0.15).abs() < 1e-7);
+    }
+    assert_eq!(glt.pmf(&ctx, LightId::Unbounded(2)), 0.0);
     for _ in 0..100 {
-        glt.splat_at(Vec3::ZERO, LightId::Environment, 3.0);
+        glt.splat_at(Vec3::ZERO, sky, 3.0);
         glt.splat_at(Vec3::ZERO, LightId::Emitter(7), 1.0);
     }
     glt.refine();
-    // (1 - alpha) * 3/4 + alpha * 0.3
+    // The sky took 3/4 of what the cell saw; the sun nothing, so it keeps
+    // only its floor (a delta light BSDF sampling never finds: without the
+    // floor its light would be lost, a bias).
     let alpha = glt.config().cut.alpha;
-    let expect = (1.0 - alpha) * 0.75 + alpha * 0.3;
-    let env = glt.pmf_exact(&ctx, LightId::Environment);
-    assert!((env - expect).abs() < 1e-6, "{env}");
-    let total: f64 = env
+    let expect = [(1.0 - alpha) * 0.75 + alpha * 0.15, alpha * 0.15];
+    let got = [glt.pmf_exact(&ctx, sky), glt.pmf_exact(&ctx, sun)];
+    for (g, e) in got.iter().zip(expect) {
+        assert!((g - e).abs() < 1e-6, "{got:?} vs {expect:?}");
+    }
+    assert!(got[1] > 0.0);
+    let total: f64 = got.iter().sum::<f64>()
         + (0..80)
             .map(|e| glt.pmf_exact(&ctx, LightId::Emitter(e)))
             .sum::<f64>();
     assert!((total - 1.0).abs() < 1e-6);
+    // Sampling: each unbounded light is chosen at its pmf (3-sigma bounds
+    // of 40,000 draws), with the pmf it reports.
     let mut rng = Rand::new(9);
-    let mut hits = 0;
-    for _ in 0..20_000 {
+    let mut hits = [0u32; 2];
+    const N: u32 = 40_000;
+    for _ in 0..N {
         let s = glt.sample(&ctx, rng.f()).unwrap();
         assert_eq!(s.pmf, glt.pmf(&ctx, s.light));
-        hits += (s.light == LightId::Environment) as u32;
+        match s.light {
+            LightId::Unbounded(i) => hits[i as usize] += 1,
+            LightId::Emitter(_) => {}
+        }
     }
-    assert!((hits as f64 / 20_000.0 - expect).abs() < 0.02);
+    for (h, e) in hits.iter().zip(expect) {
+        let sd = (e * (1.0 - e) / f64::from(N)).sqrt();
+        assert!(
+            (f64::from(*h) / f64::from(N) - e).abs() < 3.0 * sd + 1e-4,
+            "{hits:?}"
+        );
+    }
+    // The sun gets its own learned share once it is seen.
+    for _ in 0..100 {
+        glt.splat_at(Vec3::ZERO, sun, 2.0);
+        glt.splat_at(Vec3::ZERO, sky, 2.0);
+    }
+    glt.refine();
+    let (a, b) = (glt.pmf_exact(&ctx, sky), glt.pmf_exact(&ctx, sun));
+    assert!((a - b).abs() < 1e-6 && a > 0.4, "{a} {b}");
 }
 
 /// Jitter-free splats from four threads equal a serial run: bit for bit in
@@ -362,9 +394,9 @@ fn memory_report_adds_up() {
         .sum();
     assert_eq!(m.cuts.nodes, nodes);
     assert_eq!(m.cuts.node_bytes, 12 * nodes);
-    // One sum per slot plus the environment's, and the default modulation's
-    // 7 anchor sums, per cell.
-    assert_eq!(m.cuts.sum_bytes, 8 * (2 * nodes + 8 * m.cells));
+    // One sum per slot (no unbounded light here), and the default
+    // modulation's 7 anchor sums, per cell.
+    assert_eq!(m.cuts.sum_bytes, 8 * (2 * nodes + 7 * m.cells));
     assert_eq!(m.spatial_bytes, glt.spatial().bytes());
     // Split table 4 B per node; walk table one 16-B pair per inner node +
     // root; the default importance rules' table one 64-B pair beside it.

@@ -4,8 +4,8 @@
 
 use glam::Vec3;
 use guiding::light_sampler::{
-    ImportanceTreeSampler, PowerSampler, PowerTreeSampler, UniformSampler, WithEnvironment,
-    importance,
+    ImportanceTreeSampler, PowerSampler, PowerTreeSampler, UnboundedLights, UniformSampler,
+    WithUnbounded, importance,
 };
 use guiding::light_tree::{BuildHeuristic, LightHierarchy, NodeBounds};
 use guiding::math::{Aabb, LightCone};
@@ -160,7 +160,7 @@ type Dyn<'a> = Box<dyn LightSampler + Sync + 'a>;
 fn all_samplers<'a>(
     emitters: &'a [Emitter],
     tree: &'a LightTree,
-    p_env: f32,
+    unbounded: UnboundedLights,
 ) -> Vec<(&'static str, Dyn<'a>)> {
     vec![
         ("uniform", Box::new(UniformSampler::new(emitters.len()))),
@@ -171,30 +171,36 @@ fn all_samplers<'a>(
             Box::new(ImportanceTreeSampler::new(tree)),
         ),
         (
-            "env + importance tree",
-            Box::new(WithEnvironment::new(
-                ImportanceTreeSampler::new(tree),
-                p_env,
-            )),
+            "unbounded + importance tree",
+            Box::new(WithUnbounded::new(ImportanceTreeSampler::new(tree), unbounded).unwrap()),
         ),
         (
-            "env + power",
-            Box::new(WithEnvironment::new(PowerSampler::new(emitters), p_env)),
+            "unbounded + power",
+            Box::new(WithUnbounded::new(PowerSampler::new(emitters), unbounded).unwrap()),
         ),
     ]
 }
 
-/// Every light id a sampler over `n` emitters can return, environment last.
+/// The most unbounded lights the tests give a sampler.
+const UNBOUNDED: usize = 3;
+
+/// A sun and a sky sharing probability `p`.
+fn sun_and_sky(p: f64) -> UnboundedLights {
+    UnboundedLights::new(2, p).unwrap()
+}
+
+/// Every light id a sampler over `n` emitters (and up to [`UNBOUNDED`]
+/// unbounded lights) can return, unbounded lights last.
 fn lights(n: usize) -> impl Iterator<Item = LightId> {
     (0..n as u32)
         .map(LightId::Emitter)
-        .chain([LightId::Environment])
+        .chain((0..UNBOUNDED as u32).map(LightId::Unbounded))
 }
 
 fn index(light: LightId, n: usize) -> usize {
     match light {
         LightId::Emitter(i) => i as usize,
-        LightId::Environment => n,
+        LightId::Unbounded(i) => n + i as usize,
     }
 }
 
@@ -255,7 +261,7 @@ fn check_contract_with(
         match s.sample(ctx, u) {
             Some(x) => {
                 prop_assert!(x.pmf > 0.0, "{name}: sampled pmf {}", x.pmf);
-                prop_assert!(index(x.light, n) <= n, "{name}: {:?}", x.light);
+                prop_assert!(index(x.light, n) < n + UNBOUNDED, "{name}: {:?}", x.light);
                 let p = s.pmf(ctx, x.light);
                 prop_assert_eq!(x.pmf, p, "{}: u {} chose {:?}", name, u, x.light);
             }
@@ -287,7 +293,7 @@ fn edge_us() -> Vec<f32> {
 fn check_scene(
     spec: SceneSpec,
     h: BuildHeuristic,
-    p_env: f32,
+    unbounded: UnboundedLights,
     points: usize,
 ) -> Result<(), TestCaseError> {
     let emitters = random_emitters(spec);
@@ -295,7 +301,7 @@ fn check_scene(
     let mut rng = Pcg64::seed_from_u64(spec.seed ^ 0x5eed);
     let ctxs = shading_points(&mut rng, &emitters, points);
     let us: Vec<f32> = (0..64).map(|_| uf32(&mut rng)).collect();
-    for (name, s) in all_samplers(&emitters, &tree, p_env) {
+    for (name, s) in all_samplers(&emitters, &tree, unbounded) {
         for ctx in &ctxs {
             check_contract(name, &s, emitters.len(), ctx, &us)?;
         }
@@ -326,9 +332,12 @@ proptest! {
     fn pmf_sums_to_one_and_matches_sample(
         spec in scene_spec(),
         h in 0usize..4,
-        p_env in prop_oneof![Just(0.0f32), 0.0f32..1.0, Just(1.0)],
+        k in 0..=UNBOUNDED as u32,
+        p in prop_oneof![Just(1e-6f64), 1e-6f64..1.0, Just(1.0 - 1e-6)],
     ) {
-        check_scene(spec, heuristic(h), p_env, 4)?;
+        let probability = if k == 0 { 0.0 } else { p };
+        let unbounded = UnboundedLights::new(k, probability).unwrap();
+        check_scene(spec, heuristic(h), unbounded, 4)?;
     }
 
     /// Small scenes, many of them: the corner cases of tiny trees.
@@ -341,7 +350,7 @@ proptest! {
         h in 0usize..4,
     ) {
         let spec = SceneSpec { count, seed, zero_fraction, coincident };
-        check_scene(spec, heuristic(h), 0.25, 8)?;
+        check_scene(spec, heuristic(h), sun_and_sky(0.25), 8)?;
     }
 
     /// The power-tree descent is exactly the inverse CDF of the leaves, in
@@ -366,7 +375,7 @@ fn ten_thousand_emitters() {
         zero_fraction: 0.1,
         coincident: false,
     };
-    check_scene(spec, BuildHeuristic::Sarh, 0.1, 4).unwrap();
+    check_scene(spec, BuildHeuristic::Sarh, sun_and_sky(0.1), 4).unwrap();
 }
 
 // ---------------------------------------------------------------------------
@@ -430,7 +439,7 @@ fn assert_fits(what: &str, observed: &[u64], probs: &[f64]) {
 /// Draws `draws` samples at `ctx` and tests them against `pmf`.
 fn fit(what: &str, s: &dyn LightSampler, n: usize, ctx: &ShadingContext, draws: usize, seed: u64) {
     let mut rng = Pcg64::seed_from_u64(seed);
-    let mut counts = vec![0u64; n + 1];
+    let mut counts = vec![0u64; n + UNBOUNDED];
     for _ in 0..draws {
         let x = s.sample(ctx, uf32(&mut rng)).expect("non-empty sampler");
         counts[index(x.light, n)] += 1;
@@ -475,7 +484,10 @@ fn chi_square_every_sampler() {
         ShadingContext::on_surface(Vec3::new(30.0, 0.0, 2.0), -Vec3::X),
     ];
     for (i, ctx) in ctxs.iter().enumerate() {
-        for (j, (name, s)) in all_samplers(&emitters, &tree, 0.2).into_iter().enumerate() {
+        for (j, (name, s)) in all_samplers(&emitters, &tree, sun_and_sky(0.2))
+            .into_iter()
+            .enumerate()
+        {
             let what = format!("{name} at point {i}");
             fit(&what, &s, emitters.len(), ctx, 200_000, (i * 16 + j) as u64);
         }
@@ -491,7 +503,7 @@ fn chi_square_rejects_a_wrong_pmf() {
     let ctx = ShadingContext::at(Vec3::ZERO);
     let n = emitters.len();
     let mut rng = Pcg64::seed_from_u64(99);
-    let mut counts = vec![0u64; n + 1];
+    let mut counts = vec![0u64; n + UNBOUNDED];
     for _ in 0..200_000 {
         counts[index(s.sample(&ctx, uf32(&mut rng)).unwrap().light, n)] += 1;
     }
@@ -744,12 +756,12 @@ fn deep_fit(what: &str, s: &dyn LightSampler, intervals: &[(u32, f64, f64)], top
     let ctx = ShadingContext::at(Vec3::X);
     let n = intervals.len();
     let mut rng = Pcg64::seed_from_u64(seed);
-    let mut counts = vec![0u64; n + 1];
+    let mut counts = vec![0u64; n + UNBOUNDED];
     for _ in 0..400_000 {
         let u = (u01(&mut rng) * top) as f32;
         counts[index(s.sample(&ctx, u).unwrap().light, n)] += 1;
     }
-    let mut probs = vec![0.0; n + 1];
+    let mut probs = vec![0.0; n + UNBOUNDED];
     for &(e, c, p) in intervals {
         // The part of the leaf's interval inside [0, top), renormalised.
         probs[e as usize] = ((c + p).min(top) - c.min(top)) / top;
@@ -889,9 +901,12 @@ fn inverse_pmf_estimates_one() {
     let n = emitters.len();
     let ctx = ShadingContext::on_surface(Vec3::new(0.0, -3.0, 0.5), Vec3::new(0.2, 1.0, 0.1));
     const DRAWS: usize = 1_000_000;
-    for (j, (name, s)) in all_samplers(&emitters, &tree, 0.2).into_iter().enumerate() {
+    for (j, (name, s)) in all_samplers(&emitters, &tree, sun_and_sky(0.2))
+        .into_iter()
+        .enumerate()
+    {
         let mut rng = Pcg64::seed_from_u64(1000 + j as u64);
-        let mut sums = vec![0.0f64; n + 1];
+        let mut sums = vec![0.0f64; n + UNBOUNDED];
         for _ in 0..DRAWS {
             let x = s.sample(&ctx, uf32(&mut rng)).unwrap();
             sums[index(x.light, n)] += 1.0 / (x.pmf as f64 * DRAWS as f64);
@@ -943,7 +958,7 @@ fn check_all(emitters: &[Emitter], extra_points: &[ShadingContext]) {
     ctxs.extend(shading_points(&mut rng, emitters, 8));
     for h in 0..4 {
         let tree = LightTree::build(emitters, heuristic(h)).unwrap();
-        for (name, s) in all_samplers(emitters, &tree, 0.3) {
+        for (name, s) in all_samplers(emitters, &tree, sun_and_sky(0.3)) {
             for ctx in &ctxs {
                 check_contract(name, &s, emitters.len(), ctx, &us).unwrap();
             }
@@ -967,12 +982,13 @@ fn no_emitters() {
             assert_eq!(s.sample(&ctx, u), None);
         }
         assert_eq!(s.pmf(&ctx, LightId::Emitter(0)), 0.0);
-        assert_eq!(s.pmf(&ctx, LightId::Environment), 0.0);
+        assert_eq!(s.pmf(&ctx, LightId::Unbounded(0)), 0.0);
     }
-    // The environment alone takes probability 1.
-    let env = WithEnvironment::new(ImportanceTreeSampler::new(&tree), 0.1);
-    assert_eq!(env.sample(&ctx, 0.7).unwrap().light, LightId::Environment);
-    assert_eq!(env.pmf(&ctx, LightId::Environment), 1.0);
+    // The unbounded lights alone share probability 1.
+    let env = WithUnbounded::new(ImportanceTreeSampler::new(&tree), sun_and_sky(0.1)).unwrap();
+    assert_eq!(env.sample(&ctx, 0.7).unwrap().light, LightId::Unbounded(1));
+    assert_eq!(env.pmf(&ctx, LightId::Unbounded(0)), 0.5);
+    assert_eq!(env.pmf(&ctx, LightId::Unbounded(1)), 0.5);
     check_all(&[], &[]);
 }
 
@@ -1241,7 +1257,7 @@ fn samplers_are_sync_and_work_across_threads() {
     assert_sync::<PowerSampler>();
     assert_sync::<PowerTreeSampler<&'static LightTree>>();
     assert_sync::<ImportanceTreeSampler<&'static LightTree>>();
-    assert_sync::<WithEnvironment<PowerSampler>>();
+    assert_sync::<WithUnbounded<PowerSampler>>();
 
     let emitters = fit_scene(200, 8);
     let tree = LightTree::build(&emitters, BuildHeuristic::Sarh).unwrap();
@@ -1292,7 +1308,7 @@ fn one_million_emitters() {
         ShadingContext::at(Vec3::new(50.0, -20.0, 10.0)),
         ShadingContext::on_surface(Vec3::splat(500.0), -Vec3::ONE),
     ];
-    let samplers = all_samplers(&emitters, &tree, 0.1);
+    let samplers = all_samplers(&emitters, &tree, sun_and_sky(0.1));
     for (name, s) in &samplers {
         for ctx in &ctxs {
             for _ in 0..500 {

@@ -9,8 +9,10 @@ use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::{BuildError, BuildHeuristic};
 use guiding::{
     Emitter, Error, ImportanceTreeSampler, LightId, LightSampler, LightTree, PowerSampler,
-    ShadingContext, Strategy, UniformSampler,
+    ShadingContext, Strategy, UnboundedLights, UniformSampler, WithUnbounded,
 };
+
+const NONE: UnboundedLights = UnboundedLights::NONE;
 
 #[test]
 fn each_name_is_its_sampler() {
@@ -26,7 +28,7 @@ fn each_name_is_its_sampler() {
     ];
     let mut rng = Rand::new(3);
     for (name, reference) in Strategy::NAMES.iter().zip(&direct) {
-        let s = Strategy::new(name, &lights[..], scene()).unwrap();
+        let s = Strategy::new(name, &lights[..], NONE, scene()).unwrap();
         assert_eq!(s.name(), *name);
         assert_eq!(s.is_empty(), reference.is_empty());
         for _ in 0..200 {
@@ -40,15 +42,60 @@ fn each_name_is_its_sampler() {
     }
 }
 
+/// With a sun and a sky, every name samples as its sampler wrapped with
+/// them (the GLT with them as its prior), and all keep the pmf summing to 1.
+#[test]
+fn each_name_takes_unbounded_lights() {
+    let lights = two_rooms();
+    let tree = LightTree::build(&lights, BuildHeuristic::default()).unwrap();
+    let sun_and_sky = UnboundedLights::new(2, 0.3).unwrap();
+    let with =
+        |s| -> Box<dyn LightSampler> { Box::new(WithUnbounded::new(s, sun_and_sky).unwrap()) };
+    let mut config = GltConfig::default();
+    config.cut.unbounded = sun_and_sky;
+    let direct: [Box<dyn LightSampler>; 4] = [
+        Box::new(WithUnbounded::new(UniformSampler::new(lights.len()), sun_and_sky).unwrap()),
+        Box::new(WithUnbounded::new(PowerSampler::new(&lights[..]), sun_and_sky).unwrap()),
+        with(ImportanceTreeSampler::new(&tree)),
+        Box::new(Glt::new(&tree, scene(), config).unwrap()),
+    ];
+    let mut rng = Rand::new(4);
+    for (name, reference) in Strategy::NAMES.iter().zip(&direct) {
+        let s = Strategy::new(name, &lights[..], sun_and_sky, scene()).unwrap();
+        for _ in 0..50 {
+            let ctx = ShadingContext::on_surface(rng.point(9.0), rng.dir());
+            let u = rng.f();
+            assert_eq!(s.sample(&ctx, u), reference.sample(&ctx, u), "{name}");
+            let ids = (0..lights.len() as u32).map(LightId::Emitter);
+            let total: f64 = ids
+                .chain([LightId::Unbounded(0), LightId::Unbounded(1)])
+                .map(|l| s.pmf_exact(&ctx, l))
+                .sum();
+            assert!((total - 1.0).abs() < 1e-5, "{name}: {total}");
+            assert!(s.pmf(&ctx, LightId::Unbounded(1)) > 0.0, "{name}");
+        }
+    }
+    let bad = UnboundedLights {
+        count: 2,
+        probability: 1.0,
+    };
+    for name in Strategy::NAMES {
+        assert!(matches!(
+            Strategy::new(name, &lights[..], bad, scene()),
+            Err(Error::Config(_))
+        ));
+    }
+}
+
 #[test]
 fn the_glt_strategy_trains() {
     let lights = two_rooms();
-    let mut s = Strategy::new("glt", &lights[..], scene()).unwrap();
+    let mut s = Strategy::new("glt", &lights[..], NONE, scene()).unwrap();
     let ctx = ShadingContext::at(Vec3::new(-5.0, 0.0, 0.0));
     let right = |s: &Strategy| -> f32 { (40..80).map(|e| s.pmf(&ctx, LightId::Emitter(e))).sum() };
     let before = right(&s);
     assert!(
-        Strategy::new("power", &lights[..], scene())
+        Strategy::new("power", &lights[..], NONE, scene())
             .unwrap()
             .glt_mut()
             .is_none()
@@ -78,13 +125,13 @@ fn the_glt_strategy_trains() {
 fn errors_are_typed() {
     let lights = two_rooms();
     assert_eq!(
-        Strategy::new("bvh", &lights[..], scene()).unwrap_err(),
+        Strategy::new("bvh", &lights[..], NONE, scene()).unwrap_err(),
         Error::UnknownStrategy
     );
     let bad = [Emitter::point(Vec3::ZERO, f32::NAN)];
     for name in ["importance", "glt"] {
         assert!(matches!(
-            Strategy::new(name, &bad[..], scene()),
+            Strategy::new(name, &bad[..], NONE, scene()),
             Err(Error::Build(BuildError::InvalidPower { emitter: 0, .. }))
         ));
     }

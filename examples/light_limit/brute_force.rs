@@ -68,7 +68,7 @@ pub struct PointTerms {
     pub direct: f64,
 }
 
-/// Draws `m` samples of one light (or the environment) from `at`; calls
+/// Draws `m` samples of one light (emitter or unbounded) from `at`; calls
 /// `keep` with each contributing one.
 fn light_samples(
     scene: &Scene,
@@ -80,15 +80,12 @@ fn light_samples(
 ) {
     for _ in 0..m {
         let u = s.next2();
-        let (point, target) = match light {
-            LightId::Emitter(e) => (scene.lights[e as usize].sample(at.p, u), e),
-            LightId::Environment => (
-                scene
-                    .environment
-                    .as_ref()
-                    .and_then(|env| env.sample(at.n, u)),
-                NO_EMITTER,
-            ),
+        let (point, target, delta) = match light {
+            LightId::Emitter(e) => (scene.lights[e as usize].sample(at.p, u), e, false),
+            LightId::Unbounded(i) => {
+                let light = &scene.unbounded[i as usize];
+                (light.sample(at.n, u), NO_EMITTER, light.is_delta())
+            }
         };
         let Some(lp) = point else { continue };
         if lp.pdf.is_nan() || lp.pdf <= 0.0 || lp.radiance.max_element() <= 0.0 {
@@ -106,7 +103,8 @@ fn light_samples(
         keep(NeeSample {
             g,
             pdf_light: f64::from(lp.pdf),
-            pdf_bsdf: f64::from(pdf_bsdf),
+            // No BSDF sample competes with a delta light.
+            pdf_bsdf: if delta { 0.0 } else { f64::from(pdf_bsdf) },
         });
     }
 }
@@ -119,7 +117,7 @@ pub fn measure(scene: &Scene, at: ShadingPoint, m: usize, k: usize, seed: u64) -
     let mut direct = 0.0;
     let ids = (0..scene.lights.len() as u32)
         .map(LightId::Emitter)
-        .chain(scene.environment.map(|_| LightId::Environment));
+        .chain((0..scene.unbounded.len() as u32).map(LightId::Unbounded));
     for light in ids {
         let mut eval = Vec::new();
         light_samples(scene, &at, light, m, &mut s, |x| eval.push(x));
@@ -168,8 +166,8 @@ pub fn measure(scene: &Scene, at: ShadingPoint, m: usize, k: usize, seed: u64) -
                     l.pdf(at.p, bs.wi, dist, ny),
                 )
             }
-            None => match &scene.environment {
-                Some(env) => (LightId::Environment, env.radiance, env.pdf(at.n, bs.wi)),
+            None => match scene.sky() {
+                Some((id, sky)) => (id, sky.radiance, sky.pdf(at.n, bs.wi)),
                 None => continue,
             },
         };

@@ -156,24 +156,24 @@ pub fn radiance<'a>(
     recorder.clear();
     for depth in 0..max_depth {
         let Some(hit) = scene.intersect(origin, dir) else {
-            if let Some(env) = &scene.environment {
+            // The sky (the sun is a delta light: no BSDF sample finds it).
+            if let Some((id, sky)) = scene.sky() {
                 let (w, pdf_dir) = match prev {
                     Some(v) if !v.delta => {
                         let ctx = ShadingContext::on_surface(v.pos, v.normal);
-                        let p_light =
-                            guides.lights.pmf(&ctx, LightId::Environment) * env.pdf(v.normal, dir);
+                        let p_light = guides.lights.pmf(&ctx, id) * sky.pdf(v.normal, dir);
                         (power_heuristic(v.pdf_dir, p_light), v.pdf_dir)
                     }
                     _ => (1.0, 0.0),
                 };
-                recorder.add_radiance(env.radiance * w);
+                recorder.add_radiance(sky.radiance * w);
                 if let (true, Some(v)) = (train_light, prev)
                     && !v.delta
                     && pdf_dir > 0.0
                 {
-                    let value = splat_value(guides, v.f_cos, env.radiance) * w / pdf_dir;
+                    let value = splat_value(guides, v.f_cos, sky.radiance) * w / pdf_dir;
                     if value > 0.0 {
-                        splat_light(guides, &v, LightId::Environment, value, s);
+                        splat_light(guides, &v, id, value, s);
                     }
                 }
             }
@@ -266,20 +266,28 @@ pub fn radiance<'a>(
         // Next-event estimation.
         if let Some(ls) = nee.sample(&ctx, s.next()) {
             let u = s.next2();
-            let point = match ls.light {
-                LightId::Emitter(e) => scene.lights[e as usize].sample(p, u),
-                LightId::Environment => scene.environment.as_ref().and_then(|env| env.sample(n, u)),
+            let (point, delta) = match ls.light {
+                LightId::Emitter(e) => (scene.lights[e as usize].sample(p, u), false),
+                LightId::Unbounded(i) => {
+                    let light = &scene.unbounded[i as usize];
+                    (light.sample(n, u), light.is_delta())
+                }
             };
             if let Some(lp) = point {
                 let (f, bsdf_pdf) = mat.eval(n, wo, lp.wi);
                 if f.max_element() > 0.0 && lp.pdf > 0.0 && lp.radiance.max_element() > 0.0 {
                     let p_light = ls.pmf * lp.pdf;
-                    let (p_dir, _) = dir_pdf(lp.wi, bsdf_pdf);
+                    // A delta light has no competing BSDF sample.
+                    let p_dir = if delta {
+                        0.0
+                    } else {
+                        dir_pdf(lp.wi, bsdf_pdf).0
+                    };
                     let w = power_heuristic(p_light, p_dir);
                     let o = offset_origin(p, n, lp.wi);
                     let target = match ls.light {
                         LightId::Emitter(e) => e,
-                        LightId::Environment => NO_EMITTER,
+                        LightId::Unbounded(_) => NO_EMITTER,
                     };
                     if !scene.occluded(o, lp.wi, lp.dist, target) {
                         let c = f * lp.radiance * (w / p_light);

@@ -266,3 +266,48 @@ impl Environment {
         n.dot(wi).max(0.0) / PI
     }
 }
+
+/// A sun: a distant light of irradiance `radiance` (on a surface facing
+/// it) arriving from the fixed direction `direction`. A delta light: BSDF
+/// sampling never finds it, so only light sampling can, and a light
+/// sampler that never chose it would be biased.
+#[derive(Clone, Copy, Debug)]
+pub struct Sun {
+    /// Unit direction from the scene towards the sun.
+    pub direction: Vec3,
+    /// Irradiance on a surface facing the sun.
+    pub radiance: Vec3,
+}
+
+/// A light without position, outside the light tree: the crate's
+/// `LightId::Unbounded(i)` is the scene's `unbounded[i]`.
+#[derive(Clone, Copy, Debug)]
+pub enum Unbounded {
+    /// A constant environment light (a sky).
+    Sky(Environment),
+    /// A distant light (a sun).
+    Sun(Sun),
+}
+
+impl Unbounded {
+    /// A light sample towards it from a point with normal `n`. For the
+    /// sun, `pdf` is 1 (a delta: no BSDF sample competes with it).
+    #[inline]
+    pub fn sample(&self, n: Vec3, u: Vec2) -> Option<LightPoint> {
+        match self {
+            Self::Sky(sky) => sky.sample(n, u),
+            Self::Sun(sun) => Some(LightPoint {
+                wi: sun.direction,
+                dist: f32::INFINITY,
+                pdf: 1.0,
+                radiance: sun.radiance,
+            }),
+        }
+    }
+
+    /// Whether it is a delta light (BSDF sampling never hits it).
+    #[inline]
+    pub fn is_delta(&self) -> bool {
+        matches!(self, Self::Sun(_))
+    }
+}

@@ -5,9 +5,7 @@
 use crate::scene::Scene;
 use guiding::field::{FieldConfig, GuidingField};
 use guiding::glt::{BelowCut, CutConfig, Glt, GltConfig, Modulation, Prior};
-use guiding::light_sampler::{
-    ImportanceTreeSampler, PowerSampler, UniformSampler, WithEnvironment,
-};
+use guiding::light_sampler::{ImportanceTreeSampler, PowerSampler, UniformSampler, WithUnbounded};
 use guiding::sd_tree::{SdTree, SdTreeConfig};
 use guiding::spatial::SpatialFilter;
 use guiding::{LightSampler, LightTree};
@@ -152,30 +150,29 @@ impl GuideParams {
 }
 
 /// A fixed (untrained) light sampler for `method`, with the scene's
-/// environment light beside it; `None` for GLT methods.
+/// unbounded lights beside it; `None` for GLT methods.
 pub fn fixed_sampler<'a>(
     scene: &'a Scene,
     method: Method,
 ) -> Option<Box<dyn LightSampler + Sync + 'a>> {
-    let env = scene.environment.map(|_| scene.environment_probability);
     fn wrap<'a, S: LightSampler + Sync + 'a>(
         s: S,
-        env: Option<f32>,
+        scene: &Scene,
     ) -> Box<dyn LightSampler + Sync + 'a> {
-        match env {
-            Some(p) => Box::new(WithEnvironment::new(s, p)),
-            None => Box::new(s),
-        }
+        let valid = "the scene's share was validated when it was built";
+        Box::new(WithUnbounded::new(s, scene.unbounded_lights).expect(valid))
     }
     match method {
-        Method::PtUniform | Method::Ppg => Some(wrap(UniformSampler::new(scene.lights.len()), env)),
-        Method::PtPower => Some(wrap(PowerSampler::new(&scene.emitters), env)),
-        Method::PtBvh => Some(wrap(ImportanceTreeSampler::new(&scene.light_tree), env)),
+        Method::PtUniform | Method::Ppg => {
+            Some(wrap(UniformSampler::new(scene.lights.len()), scene))
+        }
+        Method::PtPower => Some(wrap(PowerSampler::new(&scene.emitters), scene)),
+        Method::PtBvh => Some(wrap(ImportanceTreeSampler::new(&scene.light_tree), scene)),
         Method::PtGlt | Method::PpgGlt => None,
     }
 }
 
-/// The cuts' configuration: sigma, and the environment light's prior.
+/// The cuts' configuration: sigma, and the unbounded lights' prior.
 fn cut_config(scene: &Scene, params: &GuideParams) -> CutConfig {
     CutConfig {
         sigma: params.sigma,
@@ -184,9 +181,7 @@ fn cut_config(scene: &Scene, params: &GuideParams) -> CutConfig {
         alpha: params.alpha,
         modulation: params.modulation,
         prior: params.prior,
-        environment: scene
-            .environment
-            .map(|_| f64::from(scene.environment_probability)),
+        unbounded: scene.unbounded_lights,
         ..CutConfig::default()
     }
 }

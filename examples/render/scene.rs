@@ -4,12 +4,12 @@
 use crate::bvh::{Bvh, Hit};
 use crate::camera::Camera;
 use crate::geometry::{NO_EMITTER, Primitive};
-use crate::lights::{Environment, Light, LightKind};
+use crate::lights::{Light, LightKind, Unbounded};
 use crate::materials::{Material, MaterialKind};
 use glam::Vec3;
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Aabb;
-use guiding::{Emitter, LightTree};
+use guiding::{Emitter, LightTree, UnboundedLights};
 
 /// The light-transport effects a scene needs. Building a scene checks that
 /// it uses nothing it did not declare; the integrator implements exactly
@@ -28,8 +28,10 @@ pub struct Effects {
     pub sphere_lights: bool,
     /// Triangle (mesh) emitters.
     pub triangle_lights: bool,
-    /// A constant environment light.
-    pub environment: bool,
+    /// A constant environment light (a sky).
+    pub sky: bool,
+    /// A distant delta light (a sun).
+    pub sun: bool,
     /// Maximum number of path segments from the camera.
     pub max_depth: u32,
 }
@@ -45,7 +47,8 @@ impl Effects {
             (self.quad_lights, "quad lights"),
             (self.sphere_lights, "sphere lights"),
             (self.triangle_lights, "triangle lights"),
-            (self.environment, "environment"),
+            (self.sky, "sky"),
+            (self.sun, "sun"),
         ];
         for (on, name) in flags {
             if on {
@@ -90,15 +93,17 @@ pub struct Scene {
     pub emitters: Vec<Emitter>,
     /// The global light tree, built once.
     pub light_tree: LightTree,
-    /// Optional environment light.
-    pub environment: Option<Environment>,
+    /// The unbounded lights (sky, sun): the crate's
+    /// `LightId::Unbounded(i)` is `unbounded[i]`.
+    pub unbounded: Vec<Unbounded>,
     /// Camera.
     pub camera: Camera,
     /// Bounds of all geometry.
     pub bounds: Aabb,
-    /// Probability with which fixed light samplers choose the environment
-    /// (and the GLT's prior for it).
-    pub environment_probability: f32,
+    /// The unbounded lights as the crate sees them: how many, and the
+    /// probability fixed light samplers choose one with (the GLT's prior
+    /// for them).
+    pub unbounded_lights: UnboundedLights,
     /// A hash of the scene's content, part of the reference cache key.
     pub fingerprint: u64,
     /// False when emitters seen directly by the camera (also through
@@ -109,6 +114,17 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// The sky (the one non-delta unbounded light) and its id, if any.
+    pub fn sky(&self) -> Option<(guiding::LightId, &crate::lights::Environment)> {
+        self.unbounded
+            .iter()
+            .enumerate()
+            .find_map(|(i, u)| match u {
+                Unbounded::Sky(sky) => Some((guiding::LightId::Unbounded(i as u32), sky)),
+                Unbounded::Sun(_) => None,
+            })
+    }
+
     /// Closest hit.
     #[inline]
     pub fn intersect(&self, origin: Vec3, dir: Vec3) -> Option<Hit> {
@@ -268,7 +284,7 @@ impl SceneBuilder {
         name: &str,
         effects: Effects,
         camera: Camera,
-        environment: Option<Vec3>,
+        unbounded: Vec<Unbounded>,
     ) -> Scene {
         for m in &self.materials {
             assert!(
@@ -284,10 +300,13 @@ impl SceneBuilder {
                 l.kind()
             );
         }
-        assert_eq!(
-            environment.is_some(),
-            effects.environment,
-            "scene {name}: environment light and its declaration disagree"
+        let count = |sun| {
+            let is = |u: &&Unbounded| matches!(u, Unbounded::Sun(_)) == sun;
+            unbounded.iter().filter(is).count()
+        };
+        assert!(
+            count(false) == usize::from(effects.sky) && (count(true) > 0) == effects.sun,
+            "scene {name}: unbounded lights and their declaration disagree (one sky at most)"
         );
         let mut bounds = Aabb::EMPTY;
         for p in &self.prims {
@@ -303,10 +322,22 @@ impl SceneBuilder {
                 fingerprint ^ u64::from(l.to_emitter().power.to_bits()) ^ (l.kind() as u64),
             );
         }
+        for u in &unbounded {
+            let (kind, v) = match u {
+                Unbounded::Sky(sky) => (1, sky.radiance),
+                Unbounded::Sun(sun) => (2, sun.radiance + sun.direction * 7.0),
+            };
+            for x in v.to_array() {
+                fingerprint = crate::rng::mix64(fingerprint ^ kind ^ u64::from(x.to_bits()));
+            }
+        }
         for v in camera.eye.to_array() {
             fingerprint = crate::rng::mix64(fingerprint ^ u64::from(v.to_bits()));
         }
-        let environment_probability = if environment.is_some() { 0.25 } else { 0.0 };
+        let unbounded_lights = match unbounded.len() as u32 {
+            0 => UnboundedLights::NONE,
+            n => UnboundedLights::new(n, 0.25).expect("a valid share"),
+        };
         Scene {
             name: name.to_string(),
             effects,
@@ -315,10 +346,10 @@ impl SceneBuilder {
             lights: self.lights,
             emitters,
             light_tree,
-            environment: environment.map(|radiance| Environment { radiance }),
+            unbounded,
             camera,
             bounds,
-            environment_probability,
+            unbounded_lights,
             fingerprint,
             camera_sees_emitters: !self.hide_emitters,
         }

@@ -1,6 +1,7 @@
 //! Parameters of the Guiding Light Tree: the per-cell cut ([`CutConfig`]).
 
 use crate::error::{self, ConfigError};
+use crate::light_sampler::UnboundedLights;
 use crate::math::Accumulation;
 
 /// How the cut's sampling continues below the cut, inside the cluster a cut
@@ -135,11 +136,13 @@ pub struct CutConfig {
     /// How a newly split slot's weight is shared. Default
     /// [`SplitPrior::Half`].
     pub split_prior: SplitPrior,
-    /// An environment (infinite) light beside the emitters: `Some(q)` with
-    /// the prior probability `q` of choosing it, `None` for none. The learned
-    /// probability is `env / (env + emitters)` of the splatted values, mixed
-    /// with `q` by `alpha` like the emitters. Default `None`.
-    pub environment: Option<f64>,
+    /// The scene's unbounded lights (distant and infinite, beside the
+    /// emitters) and their prior probability `q` together. Each one's
+    /// learned share is its fraction of the splatted values in the cell,
+    /// mixed with its prior share `q / count` by `alpha` like the emitters,
+    /// so `alpha * q / count` is its floor. Default
+    /// [`UnboundedLights::NONE`].
+    pub unbounded: UnboundedLights,
     /// How the training sums accumulate. Default [`Accumulation::Fast`];
     /// [`Accumulation::Deterministic`] gives bit-identical learned cuts
     /// whatever the thread count (48 bytes per sum instead of 8).
@@ -166,7 +169,7 @@ impl Default for CutConfig {
             modulation: Modulation::Importance,
             prior: Prior::Importance,
             split_prior: SplitPrior::Half,
-            environment: None,
+            unbounded: UnboundedLights::NONE,
             accumulation: Accumulation::Fast,
             min_splats: 64,
         }
@@ -213,20 +216,11 @@ impl CutConfig {
             || self.prior == Prior::Importance
     }
 
-    /// Checks every field: `sigma` and `alpha` in `[0, 1]`, the
-    /// environment's prior probability in `[0, 1)` (at 1 no emitter could
-    /// ever be sampled).
+    /// Checks every field: `sigma` and `alpha` in `[0, 1]`, the unbounded
+    /// lights' prior as [`UnboundedLights::validate`] says.
     pub fn validate(&self) -> Result<(), ConfigError> {
         error::unit("CutConfig::sigma", self.sigma)?;
         error::unit("CutConfig::alpha", self.alpha)?;
-        if let Some(q) = self.environment {
-            error::check(
-                "CutConfig::environment",
-                q,
-                (0.0..1.0).contains(&q),
-                "in [0, 1)",
-            )?;
-        }
-        Ok(())
+        self.unbounded.validate()
     }
 }

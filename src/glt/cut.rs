@@ -5,6 +5,7 @@ use super::config::CutConfig;
 use super::cut_node::{CutNode, Slot};
 use crate::light_tree::LightHierarchy;
 use crate::math::{Counter, Side, SumBuffer};
+use alloc::boxed::Box;
 use alloc::vec;
 use alloc::vec::Vec;
 use glam::Vec3;
@@ -18,7 +19,7 @@ use glam::Vec3;
 ///   cluster (a single-light scene, or `sigma >= 1`).
 /// - The *accumulating* copy is a set of thread-safe sums (`src/math/sum.rs`), one per slot (sum
 ///   `2 i + side` for slot `side` of node `i`; a single sum for the root
-///   cluster of an empty cut) and one last sum for the environment light.
+///   cluster of an empty cut) and, last, one sum per unbounded light.
 ///
 /// A cut is used through the [`CutRules`](super::CutRules) of its
 /// light tree: [`CutRules::new_cut`](super::CutRules::new_cut) makes
@@ -29,9 +30,10 @@ use glam::Vec3;
 pub struct GuidingCut {
     pub(super) nodes: Vec<CutNode>,
     pub(super) sums: SumBuffer,
-    /// Learned probability of the environment light among everything the
-    /// cell collected (before the mixture with the prior).
-    pub(super) env_fraction: f32,
+    /// Learned probability of each unbounded light among everything the
+    /// cell collected (before the mixture with the prior); empty without
+    /// unbounded lights.
+    pub(super) unbounded: Box<[f32]>,
     /// Non-zero splats recorded since the last rebuild (see
     /// [`CutConfig::min_splats`]).
     pub(super) recorded: Counter,
@@ -94,7 +96,8 @@ pub enum CutError {
 pub struct CutMemory {
     /// Number of cut nodes in the sampled copy.
     pub nodes: usize,
-    /// Bytes of the sampled copy's nodes ([`CutNode::BYTES`] each).
+    /// Bytes of the sampled copy: its nodes ([`CutNode::BYTES`] each) and
+    /// the unbounded lights' learned fractions (4 each).
     pub node_bytes: usize,
     /// Bytes of the accumulating copy's sums.
     pub sum_bytes: usize,
@@ -138,11 +141,13 @@ impl GuidingCut {
             }
             None => Vec::new(),
         };
-        let sums = SumBuffer::new(sum_count(nodes.len()), config.accumulation);
+        let k = config.unbounded.count;
+        let sums = SumBuffer::new(sum_count(nodes.len(), k), config.accumulation);
         Self {
             nodes,
             sums,
-            env_fraction: config.environment.unwrap_or(0.0) as f32,
+            // Before any data, each unbounded light has its prior share.
+            unbounded: vec![config.unbounded.each() as f32; k as usize].into_boxed_slice(),
             recorded: Counter::new(),
             anchor: SumBuffer::new(anchor_sums(config), config.accumulation),
             modulated,
@@ -155,19 +160,21 @@ impl GuidingCut {
         &self.nodes
     }
 
-    /// The learned fraction of the environment light (before the mixture
-    /// with its prior); 0 when there is no environment light.
+    /// The learned fraction of each unbounded light (before the mixture
+    /// with its prior), in the order of [`crate::LightId::Unbounded`];
+    /// empty without unbounded lights.
     #[inline]
-    pub fn env_fraction(&self) -> f32 {
-        self.env_fraction
+    pub fn unbounded_fractions(&self) -> &[f32] {
+        &self.unbounded
     }
 
     /// What has been splatted since the last refinement: the emitters' total
-    /// and the environment's.
+    /// and the unbounded lights' total.
     pub fn accumulated(&self) -> (f64, f64) {
         let n = self.sums.len();
-        let emitters = (0..n.saturating_sub(1)).map(|i| self.sums.get(i)).sum();
-        (emitters, self.sums.get(n.saturating_sub(1)))
+        let first = self.first_unbounded_sum();
+        let total = |r: core::ops::Range<usize>| r.map(|i| self.sums.get(i)).sum();
+        (total(0..first), total(first..n))
     }
 
     /// The light-tree nodes where the cut ends (the clusters), each with the
@@ -209,7 +216,7 @@ impl GuidingCut {
     /// Then each root-to-leaf path of the light tree crosses exactly one
     /// slot that ends the cut.
     pub fn check<H: LightHierarchy + ?Sized>(&self, tree: &H) -> Result<(), CutError> {
-        if self.sums.len() != sum_count(self.nodes.len()) {
+        if self.sums.len() != sum_count(self.nodes.len(), self.unbounded.len() as u32) {
             return Err(CutError::SumCount);
         }
         if self.nodes.is_empty() {
@@ -259,15 +266,19 @@ impl GuidingCut {
     pub fn memory(&self) -> CutMemory {
         CutMemory {
             nodes: self.nodes.len(),
-            node_bytes: self.nodes.len() * CutNode::BYTES,
+            node_bytes: self.nodes.len() * CutNode::BYTES + self.unbounded.len() * 4,
             sum_bytes: self.sums.bytes() + self.anchor.bytes(),
             inline_bytes: core::mem::size_of::<Self>(),
         }
     }
 
-    /// Heap bytes (nodes and sums), without the value itself.
+    /// Heap bytes (nodes, sums and the unbounded lights' fractions),
+    /// without the value itself.
     pub fn heap_bytes(&self) -> usize {
-        self.nodes.len() * CutNode::BYTES + self.sums.bytes() + self.anchor.bytes()
+        self.nodes.len() * CutNode::BYTES
+            + self.sums.bytes()
+            + self.anchor.bytes()
+            + self.unbounded.len() * 4
     }
 
     /// Adds the position `p` a splat came from, with `weight` (its share
@@ -306,10 +317,11 @@ impl GuidingCut {
         a.is_finite().then_some(a)
     }
 
-    /// Index of the environment light's sum.
+    /// Index of the first unbounded light's sum (the number of cluster
+    /// sums).
     #[inline]
-    pub(super) fn env_sum(&self) -> usize {
-        sum_count(self.nodes.len()) - 1
+    pub(super) fn first_unbounded_sum(&self) -> usize {
+        self.sums.len() - self.unbounded.len()
     }
 }
 
@@ -325,8 +337,8 @@ pub(super) fn anchor_sums(config: &CutConfig) -> usize {
 }
 
 /// Sums for a cut of `nodes` nodes: one per slot (one for the root cluster
-/// of an empty cut) plus the environment's.
+/// of an empty cut) plus one per unbounded light.
 #[inline]
-pub(super) fn sum_count(nodes: usize) -> usize {
-    (2 * nodes).max(1) + 1
+pub(super) fn sum_count(nodes: usize, unbounded: u32) -> usize {
+    (2 * nodes).max(1) + unbounded as usize
 }

@@ -158,8 +158,8 @@ impl<H: LightHierarchy> CutRules<H> {
     /// tree-by-power sampling (below the cut as [`BelowCut`](super::BelowCut)
     /// says). With [`Modulation::Importance`](super::Modulation::Importance) both sides start with equal factors, so
     /// the cut samples by the importance at the shading point. A tree whose root is a leaf (or that is
-    /// empty) gets the empty cut. The environment fraction starts at its
-    /// prior.
+    /// empty) gets the empty cut. Each unbounded light's fraction starts at
+    /// its prior share.
     pub fn new_cut(&self) -> GuidingCut {
         GuidingCut::new(&self.tree, &self.config)
     }

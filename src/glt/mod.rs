@@ -11,7 +11,7 @@
 //!   [`CutNode`]s, accumulating sums);
 //! - `cut_node.rs`: the 12-byte [`CutNode`] and its [`Slot`]s;
 //! - `sampling.rs`: **the GLT's sampling rule** and its pmf (cut, then the
-//!   light tree, mixed with the power prior and the environment light);
+//!   light tree, mixed with the prior and the unbounded lights);
 //! - `walk.rs`: the light tree re-laid out for the sampling walk (both
 //!   children of a node in one 16-byte load);
 //! - `splat.rs`: recording direct-light estimates ([`CutRules::splat`]);

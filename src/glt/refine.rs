@@ -44,7 +44,8 @@ impl<H: LightHierarchy> CutRules<H> {
     /// one pass may split several levels. A slot at or below `sigma * T`
     /// ends the cut, which merges any old subtree under it. The new
     /// `p_left = w_left / (w_left + w_right)` (weights in `f64`, stored as
-    /// `f32`). The environment fraction becomes `env / (env + T)`.
+    /// `f32`). Unbounded light `i`'s fraction becomes `U_i / (U + T)`, `U`
+    /// the unbounded lights' total.
     pub fn refine(&self, cut: &mut GuidingCut) -> bool {
         let config = self.config();
         if cut.recorded.get() < u64::from(config.min_splats) {
@@ -52,13 +53,17 @@ impl<H: LightHierarchy> CutRules<H> {
             return false;
         }
         cut.recorded.reset();
-        let n = cut.nodes.len();
-        let clusters = sum_count(n) - 1;
+        let clusters = cut.first_unbounded_sum();
         let sums: Vec<f64> = (0..clusters).map(|i| cut.sums.get(i)).collect();
-        let env = cut.sums.get(clusters);
+        let unbounded: Vec<f64> = (clusters..cut.sums.len())
+            .map(|i| cut.sums.get(i))
+            .collect();
         let total: f64 = sums.iter().sum();
-        if config.environment.is_some() && env + total > 0.0 {
-            cut.env_fraction = (env / (env + total)) as f32;
+        let all = total + unbounded.iter().sum::<f64>();
+        if all > 0.0 && all.is_finite() {
+            for (f, u) in cut.unbounded.iter_mut().zip(&unbounded) {
+                *f = (u / all) as f32;
+            }
         }
         let rebuilt = total > 0.0 && total.is_finite();
         if rebuilt {
@@ -74,7 +79,8 @@ impl<H: LightHierarchy> CutRules<H> {
             cut.modulated = anchor.is_some();
             cut.nodes = rebuild(self, &cut.nodes, &sums, total, anchor);
         }
-        cut.sums.reset(sum_count(cut.nodes.len()));
+        cut.sums
+            .reset(sum_count(cut.nodes.len(), config.unbounded.count));
         cut.anchor.clear();
         rebuilt
     }

@@ -3,12 +3,13 @@
 //! For a shading point in a cell with cut `C`, emitter `l` is chosen with
 //!
 //! ```text
-//! pmf(l)   = (1 - alpha) (1 - f) P_cut(l) + alpha (1 - q) P_prior(l)
-//! pmf(env) = (1 - alpha) f + alpha q
+//! pmf(l)   = (1 - alpha) (1 - F) P_cut(l) + alpha (1 - q) P_prior(l)
+//! pmf(u_i) = (1 - alpha) f_i + alpha q / k
 //! ```
 //!
-//! where `f` is the cell's learned environment fraction, `q` the user's
-//! prior probability of the environment (both 0 without one), `P_prior` the
+//! where `f_i` is the cell's learned fraction of unbounded light `u_i` (of
+//! `k`, `F` their sum), `q` the user's prior probability of the unbounded
+//! lights together (both 0 without any), `P_prior` the
 //! prior's pmf from the light tree's root (tree-by-power, or
 //! tree-by-importance at the shading point with [`Prior::Importance`]), and
 //! `P_cut` the product of the cut's probabilities down to the slot that ends
@@ -21,7 +22,8 @@
 //! inside the cell.
 //!
 //! One uniform number drives everything through one [`Descent`]: first
-//! environment or emitters, then which mixture component, then the walk
+//! unbounded lights or emitters (then which unbounded light), then which
+//! mixture component, then the walk
 //! from the light tree's root to a leaf under the chosen component's
 //! probabilities. Along that one walk both products (`P_cut` and `P_prior`)
 //! are tracked, so the mixture pmf of the chosen emitter is known without a
@@ -36,16 +38,23 @@ use super::cut_node::CutNode;
 use super::cut_rules::{CutRules, decode_split};
 use super::walk::WalkNode;
 use crate::emitter::ShadingContext;
-use crate::light_sampler::{FastQuery, ImportanceTable, LightId, LightSample, LightSampler};
+use crate::light_sampler::{
+    FastQuery, ImportanceTable, LightId, LightSample, LightSampler, choose_unbounded,
+};
 use crate::light_tree::LightHierarchy;
 use crate::math::{Descent, Side, pmf_to_f32};
 
 /// The probabilities of the top-level choices in one cell.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Mixture {
-    /// Probability of the environment light.
-    pub(crate) env: f64,
-    /// Weight of the learned component (`(1 - alpha)(1 - f)`).
+    /// Probability of the unbounded lights together.
+    pub(crate) unbounded: f64,
+    /// Unbounded light `i` has probability `learned * f_i + floor` (`f_i`
+    /// its learned fraction in the cell).
+    learned: f64,
+    floor: f64,
+    /// Weight of the learned component (`(1 - alpha)(1 - F)`, `F` the
+    /// unbounded lights' learned fractions together).
     pub(crate) cut: f64,
     /// Weight of the prior component (`alpha (1 - q)`).
     pub(crate) prior: f64,
@@ -53,35 +62,51 @@ pub(crate) struct Mixture {
 
 impl Mixture {
     /// The mixture for `cut` under a validated `config`. Emitters get
-    /// nothing when the light tree has no power at all (then the
-    /// environment, if any, gets everything).
+    /// nothing when the light tree has no power at all (then the unbounded
+    /// lights, if any, share everything in proportion to their weights).
     #[inline]
     pub(crate) fn new(emitters: bool, cut: &GuidingCut, config: &CutConfig) -> Self {
         let a = config.alpha;
-        match (config.environment, emitters) {
-            (None, false) => Self {
-                env: 0.0,
-                cut: 0.0,
-                prior: 0.0,
-            },
-            (Some(_), false) => Self {
-                env: 1.0,
-                cut: 0.0,
-                prior: 0.0,
-            },
-            (None, true) => Self {
-                env: 0.0,
-                cut: 1.0 - a,
-                prior: a,
-            },
-            (Some(q), true) => {
-                let f = (cut.env_fraction as f64).clamp(0.0, 1.0);
-                Self {
-                    env: (1.0 - a) * f + a * q,
-                    cut: (1.0 - a) * (1.0 - f),
-                    prior: a * (1.0 - q),
-                }
-            }
+        let k = cut.unbounded.len();
+        if k == 0 {
+            return Self {
+                unbounded: 0.0,
+                learned: 0.0,
+                floor: 0.0,
+                cut: if emitters { 1.0 - a } else { 0.0 },
+                prior: if emitters { a } else { 0.0 },
+            };
+        }
+        let q = config.unbounded.probability;
+        // The learned fractions sum to at most 1 up to their f32 rounding;
+        // scale them down if they overshoot, so every weight stays >= 0.
+        let f: f64 = cut.unbounded.iter().map(|&x| f64::from(x.max(0.0))).sum();
+        let scale = if f > 1.0 { 1.0 / f } else { 1.0 };
+        let f = f * scale;
+        let (learned, floor) = ((1.0 - a) * scale, a * q / k as f64);
+        if emitters {
+            return Self {
+                unbounded: (1.0 - a) * f + a * q,
+                learned,
+                floor,
+                cut: (1.0 - a) * (1.0 - f),
+                prior: a * (1.0 - q),
+            };
+        }
+        // Only unbounded lights: normalize their weights (equal shares
+        // when none has weight).
+        let total = (1.0 - a) * f + a * q;
+        let (learned, floor) = if total > 0.0 {
+            (learned / total, floor / total)
+        } else {
+            (0.0, 1.0 / k as f64)
+        };
+        Self {
+            unbounded: 1.0,
+            learned,
+            floor,
+            cut: 0.0,
+            prior: 0.0,
         }
     }
 
@@ -90,6 +115,13 @@ impl Mixture {
     #[inline]
     fn emitter_pmf(&self, p: Products) -> f64 {
         self.cut * p.cut + self.prior * p.prior
+    }
+
+    /// The pmf of unbounded light `i`, of fraction `f` in the cell.
+    /// Sampling and evaluation both end here.
+    #[inline]
+    fn unbounded_pmf(&self, f: f32) -> f64 {
+        self.learned * f64::from(f.max(0.0)) + self.floor
     }
 }
 
@@ -152,6 +184,8 @@ pub(crate) struct Rule<'b, H: LightHierarchy> {
     /// tracked and stays 1, multiplied by a zero weight).
     prior: bool,
     mixture: Mixture,
+    /// The cell's learned fractions of the unbounded lights.
+    unbounded: &'b [f32],
 }
 
 impl<'b, H: LightHierarchy> Rule<'b, H> {
@@ -181,6 +215,7 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
             },
             prior: mixture.prior > 0.0,
             mixture,
+            unbounded: &cut.unbounded,
         }
     }
 
@@ -287,10 +322,13 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
     /// Samples a light with the descent `d`; the light and its `f64` pmf.
     pub(crate) fn sample(&self, mut d: Descent) -> Option<(LightId, f64)> {
         let m = self.mixture;
-        if m.env > 0.0 {
-            let (pe, pt) = Descent::probabilities(m.env, m.cut + m.prior)?;
-            if d.choose_with(pe, pt) == Side::Left {
-                return Some((LightId::Environment, m.env));
+        if m.unbounded > 0.0 {
+            let (pu, pe) = Descent::probabilities(m.unbounded, m.cut + m.prior)?;
+            if d.choose_with(pu, pe) == Side::Left {
+                let f = self.unbounded;
+                let weight = |i: u32| m.unbounded_pmf(f[i as usize]);
+                let i = choose_unbounded(&mut d, f.len() as u32, weight)?;
+                return Some((LightId::Unbounded(i), weight(i)));
             }
         }
         let use_cut = match (m.cut > 0.0, self.prior) {
@@ -333,7 +371,12 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
     /// The `f64` pmf of `light`: the same steps along its path.
     pub(crate) fn pmf(&self, light: LightId) -> f64 {
         let emitter = match light {
-            LightId::Environment => return self.mixture.env,
+            LightId::Unbounded(i) => {
+                return self
+                    .unbounded
+                    .get(i as usize)
+                    .map_or(0.0, |&f| self.mixture.unbounded_pmf(f));
+            }
             LightId::Emitter(e) => e,
         };
         if self.mixture.cut <= 0.0 && !self.prior {
@@ -383,12 +426,12 @@ impl<H: LightHierarchy> CutRules<H> {
     /// one uniform number `u` in `[0, 1)`, by the GLT's sampling rule:
     ///
     /// ```text
-    /// pmf(l)   = (1 - alpha) (1 - f) P_cut(l) + alpha (1 - q) P_prior(l)
-    /// pmf(env) = (1 - alpha) f + alpha q
+    /// pmf(l)   = (1 - alpha) (1 - F) P_cut(l) + alpha (1 - q) P_prior(l)
+    /// pmf(u_i) = (1 - alpha) f_i + alpha q / k
     /// ```
     ///
-    /// (`f` the cell's learned environment fraction, `q` the configured
-    /// prior one, `P_prior` the [`Prior`] rule from the root, `P_cut` the
+    /// (`f_i` the cell's learned fraction of unbounded light `i` of `k`, `F`
+    /// their sum, `q` their configured prior together, `P_prior` the [`Prior`] rule from the root, `P_cut` the
     /// cut's learned probabilities, [`Modulation`] applied, down to the cut,
     /// then the [`BelowCut`] rule; the full description is at the top of
     /// `src/glt/sampling.rs`). `None` when
@@ -491,8 +534,8 @@ impl<H: LightHierarchy> LightSampler for CutSampler<'_, H> {
 
 impl<H: LightHierarchy> CutRules<H> {
     /// True when nothing can ever be sampled: no emitter has power and
-    /// there is no environment light with a positive probability.
+    /// there is no unbounded light.
     pub fn is_empty(&self) -> bool {
-        !self.has_power() && self.config().environment.is_none_or(|q| q <= 0.0)
+        !self.has_power() && self.config().unbounded.count == 0
     }
 }

@@ -10,15 +10,15 @@ use glam::Vec3;
 /// What became of one splat.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum SplatOutcome {
-    /// The value was added to a slot's (or the environment's) sum.
+    /// The value was added to a slot's (or an unbounded light's) sum.
     Recorded,
     /// The value was zero (an occluded or black sample): a valid
     /// observation that adds nothing to the sums. It still counts as a
     /// sample for spatial refinement.
     Zero,
     /// Bad input, ignored: a negative, NaN or infinite value, an emitter out
-    /// of range or with zero power (no cut can give it weight), or the
-    /// environment when none is configured.
+    /// of range or with zero power (no cut can give it weight), or an
+    /// unbounded light beyond [`CutConfig::unbounded`](super::CutConfig::unbounded)'s count.
     Dropped,
 }
 
@@ -59,7 +59,7 @@ impl<H: LightHierarchy> CutRules<H> {
     /// `Le * T * w_mis / (pdf_solid_angle * pmf)`; from a BSDF-sampled
     /// emitter hit, `Le * w_mis / pdf_direction` (use the luminance, or any
     /// fixed scalar, of a spectral value). The value goes to the first slot
-    /// on the emitter's path that ends the cut (or to the environment's
+    /// on the emitter's path that ends the cut (or to the unbounded light's
     /// sum). Takes `&self`: any number of threads may splat at once, no
     /// update is lost.
     ///
@@ -72,7 +72,9 @@ impl<H: LightHierarchy> CutRules<H> {
         }
         let index = match light {
             LightId::Emitter(e) => cut.slot_of(self.light_tree(), e),
-            LightId::Environment => self.config().environment.map(|_| cut.env_sum()),
+            LightId::Unbounded(i) => {
+                (i < self.config().unbounded.count).then(|| cut.first_unbounded_sum() + i as usize)
+            }
         };
         let Some(index) = index else {
             return SplatOutcome::Dropped;

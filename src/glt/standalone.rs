@@ -205,7 +205,7 @@ impl<H: LightHierarchy> Glt<H> {
 
     /// Splats dropped as bad input so far, all in [`DroppedSplats::light`]:
     /// non-finite or negative values or positions, emitters out of range or
-    /// with zero power, the environment when none is configured.
+    /// with zero power, unbounded lights beyond the configured count.
     pub fn dropped_splats(&self) -> DroppedSplats {
         self.dropped.snapshot()
     }

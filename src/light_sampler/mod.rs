@@ -12,24 +12,25 @@
 //! | [`PowerSampler`] | proportional to power (alias table, O(1)) |
 //! | [`PowerTreeSampler`] | descend a light tree by subtree power |
 //! | [`ImportanceTreeSampler`] | descend by power x orientation / distance^2 (Estevez & Kulla, pbrt-v4) |
-//! | [`WithEnvironment`] | any of the above plus an environment light with a fixed probability |
+//! | [`WithUnbounded`] | any of the above plus the scene's unbounded lights (distant, infinite) with a fixed probability |
 //! | [`crate::glt`] | the Guiding Light Tree: learned cuts, then the light tree |
 
-mod environment;
 mod importance;
 mod importance_table;
 mod power;
 mod tree_importance;
 mod tree_power;
 mod tree_walk;
+mod unbounded;
 mod uniform;
 
-pub use environment::WithEnvironment;
 pub use importance::importance;
 pub(crate) use importance_table::{FastQuery, ImportanceTable};
 pub use power::PowerSampler;
 pub use tree_importance::ImportanceTreeSampler;
 pub use tree_power::PowerTreeSampler;
+pub(crate) use unbounded::choose_unbounded;
+pub use unbounded::{UnboundedLights, WithUnbounded};
 pub use uniform::UniformSampler;
 
 use crate::emitter::ShadingContext;
@@ -37,12 +38,22 @@ use crate::emitter::ShadingContext;
 pub(crate) use crate::math::pmf_to_f32;
 
 /// A light a sampler can choose.
+///
+/// A renderer keeps its lights in two lists in its own order: the bounded
+/// ones it described as [`crate::Emitters`] (`Emitter(i)` is the `i`-th)
+/// and the unbounded ones ([`UnboundedLights`]: distant and infinite
+/// lights, `Unbounded(i)` is the `i`-th). Both directions of the mapping
+/// are then an index: a sampled id names the renderer's light, and a light
+/// a BSDF sample hit names its id for the MIS pmf. A renderer whose lights
+/// sit in one mixed list stores each light's `LightId` beside it and the
+/// two index lists back (pbrt keeps such a map for the same purpose).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum LightId {
     /// Emitter `i` of the scene's [`crate::Emitters`].
     Emitter(u32),
-    /// The environment (infinite) light, handled beside the emitters.
-    Environment,
+    /// Unbounded light `i` (see [`UnboundedLights`]), handled beside the
+    /// emitters.
+    Unbounded(u32),
 }
 
 /// A chosen light and the probability it was chosen with.

@@ -166,7 +166,7 @@ impl LightSampler for PowerSampler {
         match light {
             _ if !ctx.is_finite() => 0.0,
             LightId::Emitter(i) => self.bins.get(i as usize).map_or(0.0, |b| b.pmf),
-            LightId::Environment => 0.0,
+            LightId::Unbounded(_) => 0.0,
         }
     }
 

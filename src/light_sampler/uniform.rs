@@ -90,7 +90,7 @@ mod tests {
         assert_eq!(pick(f32::INFINITY), Some(LightId::Emitter(3)));
         assert_eq!(s.pmf(&ctx, LightId::Emitter(3)), 0.25);
         assert_eq!(s.pmf(&ctx, LightId::Emitter(4)), 0.0);
-        assert_eq!(s.pmf(&ctx, LightId::Environment), 0.0);
+        assert_eq!(s.pmf(&ctx, LightId::Unbounded(0)), 0.0);
     }
 
     #[test]

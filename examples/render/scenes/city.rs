@@ -145,5 +145,5 @@ pub fn build(size: Size) -> Scene {
     };
     let eye = Vec3::new(-0.62 * extent, 0.22 * extent + 1.5, 1.25 * extent);
     let camera = Camera::look_at(eye, Vec3::new(0.1 * extent, 0.0, 0.0), 50.0);
-    b.build("city", effects, camera, None)
+    b.build("city", effects, camera, Vec::new())
 }

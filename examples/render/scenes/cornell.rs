@@ -54,5 +54,5 @@ pub fn build(_size: Size) -> Scene {
         ..Effects::default()
     };
     let camera = Camera::look_at(Vec3::new(0.5, 0.5, -1.15), Vec3::new(0.5, 0.5, 0.5), 40.0);
-    b.build("box", effects, camera, None)
+    b.build("box", effects, camera, Vec::new())
 }

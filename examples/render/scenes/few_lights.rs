@@ -1,5 +1,7 @@
 //! `few-lights` (the paper's SPACESHIP role, the overhead case): a courtyard
-//! open to a dim sky with five emitters (three wall panels, two lamps) and,
+//! open to a dim sky and a low sun (two unbounded lights: the sun is a
+//! delta light only light sampling finds) with five emitters (three wall
+//! panels, two lamps) and,
 //! like the spaceship, real geometric detail (a finely tessellated
 //! sculpture and a few hundred small boxes, ~45k triangles), so a path
 //! costs what it costs in a production-like scene and the guiding
@@ -7,6 +9,7 @@
 
 use super::{Dice, Size, shapes};
 use crate::camera::Camera;
+use crate::lights::{Environment, Sun, Unbounded};
 use crate::materials::Material;
 use crate::scene::{Effects, Scene, SceneBuilder};
 use glam::Vec3;
@@ -95,7 +98,8 @@ pub fn build(_size: Size) -> Scene {
         glossy: true,
         quad_lights: true,
         sphere_lights: true,
-        environment: true,
+        sky: true,
+        sun: true,
         max_depth: 6,
         ..Effects::default()
     };
@@ -104,6 +108,16 @@ pub fn build(_size: Size) -> Scene {
         "few-lights",
         effects,
         camera,
-        Some(Vec3::new(0.25, 0.32, 0.45)),
+        vec![
+            Unbounded::Sky(Environment {
+                radiance: Vec3::new(0.25, 0.32, 0.45),
+            }),
+            // Low in the sky: it reaches the courtyard's floor over a wall
+            // only in part, so the lamps and panels still matter.
+            Unbounded::Sun(Sun {
+                direction: Vec3::new(0.55, 0.6, 0.58).normalize(),
+                radiance: Vec3::new(1.6, 1.4, 1.1),
+            }),
+        ],
     )
 }

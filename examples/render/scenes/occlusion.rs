@@ -100,5 +100,5 @@ pub fn build(size: Size) -> Scene {
         ..Effects::default()
     };
     let camera = Camera::look_at(Vec3::new(4.6, 1.7, 3.6), Vec3::new(1.5, 1.1, 0.0), 50.0);
-    b.build("occlusion", effects, camera, None)
+    b.build("occlusion", effects, camera, Vec::new())
 }

@@ -127,5 +127,5 @@ pub fn build(size: Size) -> Scene {
         ..Effects::default()
     };
     let camera = Camera::look_at(Vec3::new(0.5, 3.2, 6.5), Vec3::new(0.0, -0.9, -0.5), 50.0);
-    b.build("pool", effects, camera, None)
+    b.build("pool", effects, camera, Vec::new())
 }

@@ -108,5 +108,5 @@ pub fn build(size: Size) -> Scene {
         ..Effects::default()
     };
     let camera = Camera::look_at(Vec3::new(0.6, 2.2, 6.6), Vec3::new(0.0, 0.2, 0.0), 50.0);
-    b.build("ring", effects, camera, None)
+    b.build("ring", effects, camera, Vec::new())
 }

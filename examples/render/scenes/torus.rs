@@ -67,5 +67,5 @@ pub fn build(size: Size) -> Scene {
         ..Effects::default()
     };
     let camera = Camera::look_at(Vec3::new(0.8, 1.6, 5.5), Vec3::new(0.0, 0.9, 0.0), 45.0);
-    b.build("torus", effects, camera, None)
+    b.build("torus", effects, camera, Vec::new())
 }
