@@ -19,7 +19,7 @@ use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::UniformSampler;
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Aabb;
-use guiding::mis::power_heuristic;
+use guiding::mis::Convention;
 use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
 use rand_pcg::Pcg32;
 use rand_pcg::rand_core::{Rng, SeedableRng};
@@ -95,21 +95,22 @@ fn estimate(
     // NEE: choose a light, then a direction towards it.
     if let Some(s) = sampler.sample(&ctx, uniform(rng)) {
         let LightId::Emitter(i) = s.light else {
-            unreachable!("no environment here")
+            unreachable!("no unbounded lights here")
         };
         let light = &lights[i as usize];
         let (dir, pdf_dir) = sample_sphere(light, p, [uniform(rng), uniform(rng)]);
         let cos = n.dot(dir);
-        if cos > 0.0 && visible(p, light.center) {
-            let p_light = s.pmf * pdf_dir;
-            let w = power_heuristic(p_light, cos / PI);
-            e += light.radiance * cos * w / p_light;
-            if let Some(v) = &vertex {
-                // Splat: Le * T * w_mis / (pdf_solid_angle * pmf).
-                v.splat_light(s.light, light.radiance * w / p_light, rng);
-            }
+        let d = Convention::PbrtV4.light_sample(s.pmf, pdf_dir, cos.max(0.0) / PI);
+        // Occluded (or below the horizon): a valid sample of value 0.
+        let le = if cos > 0.0 && visible(p, light.center) {
+            light.radiance
+        } else {
+            0.0
+        };
+        e += le * cos * d.factor;
+        if let Some(v) = &vertex {
+            v.splat_light(s.light, le * d.factor, rng);
         }
-        // Occluded samples are not splatted (they would add nothing).
     }
     // BSDF sampling (cosine-weighted for a diffuse floor).
     let (u1, u2) = (uniform(rng), uniform(rng));
@@ -121,11 +122,10 @@ fn estimate(
         if visible(p, light.center) {
             let (_, pdf_dir) = sample_sphere(light, p, [0.0, 0.0]);
             let id = LightId::Emitter(i as u32);
-            let w = power_heuristic(pdf_bsdf, sampler.pmf(&ctx, id) * pdf_dir);
-            e += light.radiance * dir.y * w / pdf_bsdf;
+            let d = Convention::PbrtV4.bsdf_sample(sampler.pmf(&ctx, id), pdf_dir, pdf_bsdf);
+            e += light.radiance * dir.y * d.factor;
             if let Some(v) = &vertex {
-                // Splat: Le * w_mis / pdf_direction.
-                v.splat_light(id, light.radiance * w / pdf_bsdf, rng);
+                v.splat_light(id, light.radiance * d.factor, rng);
             }
         }
     }

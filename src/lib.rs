@@ -16,7 +16,8 @@
 //!    inverse-variance combination of the last iterations;
 //! 9. for the integrator: [`Strategy`] (a light sampler by name),
 //!    [`PathRecorder`] (a path's bookkeeping and its records) and [`mis`]
-//!    (the MIS heuristics).
+//!    (the MIS heuristics, and what a direct-light sample contributes and
+//!    records under pbrt-v4's or pbrt-v3's convention).
 //!
 //! Each of [`sd_tree::SdTree`], [`glt::Glt`] and [`field::GuidingField`]
 //! locates a path vertex once with `vertex(p)` and answers and records

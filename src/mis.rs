@@ -1,7 +1,10 @@
-//! Multiple importance sampling weights for combining next-event estimation
-//! with BSDF (or guided) sampling: the pdfs are those of the two techniques
-//! for the same sample, in the same measure (solid angle), light selection
-//! included (`pmf * pdf_light`).
+//! Multiple importance sampling for direct light: the heuristics, and the
+//! two conventions renderers combine next-event estimation with BSDF (or
+//! guided) sampling by, each with what its samples contribute and what they
+//! record for the GLT ([`Convention`], [`DirectLight`]).
+//!
+//! The heuristics take the pdfs of the two techniques for the same sample,
+//! in the same measure (solid angle).
 
 /// Veach's power heuristic (beta = 2), the weight of technique `a` against
 /// `b`: `a^2 / (a^2 + b^2)`, squared in `f64` so that neither tiny nor huge
@@ -28,6 +31,109 @@ pub fn balance_heuristic(a: f32, b: f32) -> f32 {
     let (a, b) = (f64::from(a), f64::from(b));
     let w = a / (a + b);
     if w.is_finite() { w as f32 } else { 0.0 }
+}
+
+/// How a renderer combines its light sample with its BSDF sample. Both are
+/// unbiased; they differ in which BSDF samples compete with which light,
+/// and so in the MIS weights, the contributions and the light splats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Convention {
+    /// pbrt-v4 (and the render example): one light sample per vertex from
+    /// the light sampler, and the path's own BSDF sample, which counts any
+    /// emitter it hits. The light's pdf in both weights includes its
+    /// selection pmf, evaluated for the light the BSDF sample hit.
+    PbrtV4,
+    /// pbrt-v3 (`UniformSampleOneLight` / `EstimateDirect`): one light is
+    /// chosen, then one light sample and one BSDF sample are both
+    /// estimates of that light only; a BSDF sample that hits another light
+    /// counts nothing here, and the sum is divided by the chosen light's
+    /// pmf. The weights use the light's pdf without the pmf.
+    PbrtV3,
+}
+
+/// The MIS weight of one direct-light sample and the factor that turns
+/// radiance into its contribution and its light record, under a
+/// [`Convention`]:
+///
+/// - contribution to the pixel (or to the path's radiance at the vertex):
+///   `f_cos * le * factor` (`f_cos` the BSDF value times the cosine; for a
+///   BSDF sample whose `f_cos / pdf` the path throughput already holds,
+///   that is `le * weight` added through the throughput);
+/// - value to record for the light ([`crate::glt::Glt::splat`],
+///   `splat_light` of a field vertex): `luminance(le) * factor` (or any
+///   fixed scalar of `le`), whatever its visibility: an occluded sample
+///   records 0 (see the `schedule` module's rule on zero-valued records).
+///
+/// Over the light choice and both samples, the values recorded for light
+/// `l` have as expectation the radiance it sends to the vertex (visibility
+/// included, BSDF and cosine not) integrated over the directions it
+/// covers, in both conventions; the contributions, the direct light
+/// (`tests/mis_conventions.rs`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirectLight {
+    /// The MIS weight, in `[0, 1]`.
+    pub weight: f32,
+    /// `weight / pdf` of the whole technique (see above); 0 when the
+    /// sample cannot count (zero, NaN or infinite pdfs).
+    pub factor: f32,
+}
+
+impl DirectLight {
+    /// Nothing: a sample that cannot count.
+    pub const NONE: Self = Self {
+        weight: 0.0,
+        factor: 0.0,
+    };
+
+    /// `weight / (a * b)` in `f64`, 0 when not finite or not positive.
+    #[inline]
+    fn new(weight: f32, a: f32, b: f32) -> Self {
+        let f = f64::from(weight) / (f64::from(a) * f64::from(b));
+        if f > 0.0 && f.is_finite() {
+            Self {
+                weight,
+                factor: f as f32,
+            }
+        } else {
+            Self::NONE
+        }
+    }
+}
+
+impl Convention {
+    /// The light sample of a light chosen with probability `pmf`: its
+    /// direction has solid-angle pdf `pdf_light` from the light and
+    /// `pdf_bsdf` from the vertex's direction sampling (BSDF or guided
+    /// mixture). For a delta light (a point or a sun) pass `pdf_light` 1
+    /// and `pdf_bsdf` 0: no BSDF sample competes with it, the weight is 1.
+    #[inline]
+    pub fn light_sample(self, pmf: f32, pdf_light: f32, pdf_bsdf: f32) -> DirectLight {
+        let competing = match self {
+            Self::PbrtV4 => pmf * pdf_light,
+            Self::PbrtV3 => pdf_light,
+        };
+        DirectLight::new(power_heuristic(competing, pdf_bsdf), pmf, pdf_light)
+    }
+
+    /// The BSDF sample of direction pdf `pdf_bsdf` that hit a light whose
+    /// light sampling pdf for that direction is `pdf_light`, `pmf` the
+    /// light's selection probability at the vertex (pbrt-v4: the pmf of
+    /// the light it hit, from the light sampler's `pmf`; pbrt-v3: the pmf
+    /// the chosen light was chosen with, and the sample counts only if it
+    /// hit that light).
+    #[inline]
+    pub fn bsdf_sample(self, pmf: f32, pdf_light: f32, pdf_bsdf: f32) -> DirectLight {
+        match self {
+            Self::PbrtV4 => {
+                let w = power_heuristic(pdf_bsdf, pmf * pdf_light);
+                DirectLight::new(w, pdf_bsdf, 1.0)
+            }
+            Self::PbrtV3 => {
+                let w = power_heuristic(pdf_bsdf, pdf_light);
+                DirectLight::new(w, pdf_bsdf, pmf)
+            }
+        }
+    }
 }
 
 #[cfg(test)]

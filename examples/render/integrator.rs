@@ -13,7 +13,7 @@ use crate::scene::Scene;
 use glam::Vec3;
 use guiding::field::{FieldVertex, GuidingField};
 use guiding::glt::Glt;
-use guiding::mis::power_heuristic;
+use guiding::mis::Convention;
 use guiding::path_recorder::{RadianceRecords, Segment};
 use guiding::sd_tree::{SdCell, SdTree};
 use guiding::spatial::Jitter;
@@ -137,6 +137,36 @@ fn splat_value(guides: &Guides, f_cos: Vec3, le: Vec3) -> f32 {
     }
 }
 
+/// A light (`id`, radiance `le`) found by the direction sampled at `prev`
+/// (none for a camera ray or after a specular bounce: weight 1): its
+/// MIS-weighted radiance joins the path, and, when training, its record
+/// the light's (`pdf_light` is the light's solid-angle pdf from `prev`).
+#[inline]
+fn found_light(
+    guides: &Guides,
+    prev: Option<Vertex>,
+    id: LightId,
+    pdf_light: impl Fn(&Vertex) -> f32,
+    le: Vec3,
+    recorder: &mut Recorder,
+    s: &mut Sampler,
+) {
+    let Some(v) = prev.filter(|v| !v.delta) else {
+        recorder.add_radiance(le);
+        return;
+    };
+    let pmf = guides
+        .lights
+        .pmf(&ShadingContext::on_surface(v.pos, v.normal), id);
+    let d = Convention::PbrtV4.bsdf_sample(pmf, pdf_light(&v), v.pdf_dir);
+    recorder.add_radiance(le * d.weight);
+    let train = guides.train && (guides.glt.is_some() || guides.field.is_some());
+    let value = splat_value(guides, v.f_cos, le) * d.factor;
+    if train && value > 0.0 {
+        splat_light(guides, &v, id, value, s);
+    }
+}
+
 /// The radiance arriving at the camera along `origin + t dir`.
 /// `recorder` is reused between paths (it keeps its storage).
 pub fn radiance<'a>(
@@ -158,24 +188,8 @@ pub fn radiance<'a>(
         let Some(hit) = scene.intersect(origin, dir) else {
             // The sky (the sun is a delta light: no BSDF sample finds it).
             if let Some((id, sky)) = scene.sky() {
-                let (w, pdf_dir) = match prev {
-                    Some(v) if !v.delta => {
-                        let ctx = ShadingContext::on_surface(v.pos, v.normal);
-                        let p_light = guides.lights.pmf(&ctx, id) * sky.pdf(v.normal, dir);
-                        (power_heuristic(v.pdf_dir, p_light), v.pdf_dir)
-                    }
-                    _ => (1.0, 0.0),
-                };
-                recorder.add_radiance(sky.radiance * w);
-                if let (true, Some(v)) = (train_light, prev)
-                    && !v.delta
-                    && pdf_dir > 0.0
-                {
-                    let value = splat_value(guides, v.f_cos, sky.radiance) * w / pdf_dir;
-                    if value > 0.0 {
-                        splat_light(guides, &v, id, value, s);
-                    }
-                }
+                let pdf_light = |v: &Vertex| sky.pdf(v.normal, dir);
+                found_light(guides, prev, id, pdf_light, sky.radiance, recorder, s);
             }
             break;
         };
@@ -189,25 +203,8 @@ pub fn radiance<'a>(
             let le = light.emitted(dir, ng);
             if le.max_element() > 0.0 {
                 let id = LightId::Emitter(prim.emitter);
-                let (w, pdf_dir) = match prev {
-                    Some(v) if !v.delta => {
-                        let ctx = ShadingContext::on_surface(v.pos, v.normal);
-                        let dist = (p - v.pos).length();
-                        let p_light = guides.lights.pmf(&ctx, id) * light.pdf(v.pos, dir, dist, ng);
-                        (power_heuristic(v.pdf_dir, p_light), v.pdf_dir)
-                    }
-                    _ => (1.0, 0.0),
-                };
-                recorder.add_radiance(le * w);
-                if let (true, Some(v)) = (train_light, prev)
-                    && !v.delta
-                    && pdf_dir > 0.0
-                {
-                    let value = splat_value(guides, v.f_cos, le) * w / pdf_dir;
-                    if value > 0.0 {
-                        splat_light(guides, &v, id, value, s);
-                    }
-                }
+                let pdf_light = |v: &Vertex| light.pdf(v.pos, dir, (p - v.pos).length(), ng);
+                found_light(guides, prev, id, pdf_light, le, recorder, s);
             }
         }
         let mat = scene.materials[prim.material as usize];
@@ -276,25 +273,24 @@ pub fn radiance<'a>(
             if let Some(lp) = point {
                 let (f, bsdf_pdf) = mat.eval(n, wo, lp.wi);
                 if f.max_element() > 0.0 && lp.pdf > 0.0 && lp.radiance.max_element() > 0.0 {
-                    let p_light = ls.pmf * lp.pdf;
                     // A delta light has no competing BSDF sample.
                     let p_dir = if delta {
                         0.0
                     } else {
                         dir_pdf(lp.wi, bsdf_pdf).0
                     };
-                    let w = power_heuristic(p_light, p_dir);
+                    let d = Convention::PbrtV4.light_sample(ls.pmf, lp.pdf, p_dir);
                     let o = offset_origin(p, n, lp.wi);
                     let target = match ls.light {
                         LightId::Emitter(e) => e,
                         LightId::Unbounded(_) => NO_EMITTER,
                     };
                     if !scene.occluded(o, lp.wi, lp.dist, target) {
-                        let c = f * lp.radiance * (w / p_light);
+                        let c = f * lp.radiance * d.factor;
                         if c.is_finite() {
                             recorder.add_radiance(c);
                             if train_light {
-                                let value = splat_value(guides, f, lp.radiance) * w / p_light;
+                                let value = splat_value(guides, f, lp.radiance) * d.factor;
                                 splat_light(guides, &here, ls.light, value, s);
                             }
                         }
