@@ -17,7 +17,9 @@
 //! 9. for the integrator: [`Strategy`] (a light sampler by name),
 //!    [`PathRecorder`] (a path's bookkeeping and its records) and [`mis`]
 //!    (the MIS heuristics, and what a direct-light sample contributes and
-//!    records under pbrt-v4's or pbrt-v3's convention).
+//!    records under pbrt-v4's or pbrt-v3's convention); with `std`,
+//!    [`shared_guide`] (a guide the render threads share and any of them
+//!    refines, through `&self`).
 //!
 //! Each of [`sd_tree::SdTree`], [`glt::Glt`] and [`field::GuidingField`]
 //! locates a path vertex once with `vertex(p)` and answers and records
@@ -44,7 +46,8 @@
 //! - `sample` returns exactly the probability `pmf` (or `pdf`) reports for the
 //!   same input, and pmfs sum to 1 (or are all 0 when nothing can be sampled).
 //! - Queries and records take `&self` and may run from many threads; `refine`
-//!   takes `&mut self` between iterations. [`math::Accumulation::Deterministic`]
+//!   takes `&mut self` between iterations (or `&self` through
+//!   [`shared_guide::SharedGuide`]). [`math::Accumulation::Deterministic`]
 //!   makes learned state bit-identical whatever the thread count.
 //! - Bad input never panics: builds return typed errors, records drop and
 //!   count it ([`DroppedSplats`]); invalid configuration is an error, never
@@ -74,6 +77,8 @@ pub mod path_recorder;
 pub mod quadtree;
 pub mod schedule;
 pub mod sd_tree;
+#[cfg(feature = "std")]
+pub mod shared_guide;
 pub mod spatial;
 mod strategy;
 

@@ -123,7 +123,7 @@ use glam::Vec3;
 /// `H` is the light hierarchy, held as the renderer chooses: owned
 /// (`GuidingField<LightTree>`), shared with the scene
 /// (`GuidingField<Arc<LightTree>>`) or borrowed (`GuidingField<&LightTree>`).
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct GuidingField<H: LightHierarchy> {
     cells: BinaryTree<FieldCell>,
     /// The SD-tree's configuration, iteration count and drop counters.

@@ -139,7 +139,7 @@ impl GltMemory {
 /// `H` is the light hierarchy, held as the renderer chooses: owned
 /// (`Glt<LightTree>`), shared with the scene (`Glt<Arc<LightTree>>`) or
 /// borrowed (`Glt<&LightTree>`).
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct Glt<H: LightHierarchy> {
     guide: CutRules<H>,
     config: GltConfig,

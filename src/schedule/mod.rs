@@ -30,7 +30,12 @@
 //! [`PassStats`], recording into the guiding structure as it goes; when the
 //! iteration's passes are done, call `refine()` (the one `&mut` step,
 //! between rounds, while no thread records), hand the iteration's image to
-//! the combiner and start the next iteration. Every round's image is an
+//! the combiner and start the next iteration. A renderer whose thread pool
+//! renders all its samples at once, with no point where the main thread
+//! holds `&mut`, shares the structure through
+//! `shared_guide::SharedGuide` (`std`): workers take it per tile, and the
+//! worker that completes an iteration's last tile calls its `refine(&self)`,
+//! which waits for the tiles in flight to end. Every round's image is an
 //! unbiased estimate whatever the guide learned, so the combination of the
 //! last iterations is the image at any moment. A tile-based renderer does
 //! the same with "all tiles of one round" as its pass. Records of the last
