@@ -188,8 +188,10 @@ impl<H: LightHierarchy> GuidingField<H> {
         let guide = &self.guide;
         self.sd.refine(
             &mut self.cells,
-            |cell| {
-                guide.refine(&mut cell.cut);
+            |cell| guide.growth(&cell.cut),
+            |cell, scale| {
+                let cap = scale.and_then(|_| guide.growth(&cell.cut).cap(scale));
+                guide.refine_within(&mut cell.cut, cap);
             },
             FieldCell::heap_bytes,
         )

@@ -10,6 +10,7 @@ use crate::emitter::ShadingContext;
 use crate::light_sampler::{FastQuery, ImportanceTable};
 use crate::light_tree::LightHierarchy;
 use crate::math::Side;
+use crate::spatial::Growth;
 use alloc::vec;
 use alloc::vec::Vec;
 
@@ -47,43 +48,105 @@ impl<H: LightHierarchy> CutRules<H> {
     /// `f32`). Unbounded light `i`'s fraction becomes `U_i / (U + T)`, `U`
     /// the unbounded lights' total.
     pub fn refine(&self, cut: &mut GuidingCut) -> bool {
+        self.refine_within(cut, None)
+    }
+
+    /// [`CutRules::refine`] building at most `max_nodes` cut nodes: while
+    /// the rebuild would have more, it is redone with `sigma` doubled (the
+    /// coarsest cut, at `sigma` 1, has none). Spatial structures use it to
+    /// keep their cuts within a memory budget.
+    pub(crate) fn refine_within(&self, cut: &mut GuidingCut, max_nodes: Option<usize>) -> bool {
         let config = self.config();
-        if cut.recorded.get() < u64::from(config.min_splats) {
+        let Some(plan) = self.plan(cut) else {
             // Too little data: keep the cut, keep accumulating.
             return false;
-        }
+        };
         cut.recorded.reset();
-        let clusters = cut.first_unbounded_sum();
-        let sums: Vec<f64> = (0..clusters).map(|i| cut.sums.get(i)).collect();
-        let unbounded: Vec<f64> = (clusters..cut.sums.len())
-            .map(|i| cut.sums.get(i))
-            .collect();
-        let total: f64 = sums.iter().sum();
-        let all = total + unbounded.iter().sum::<f64>();
+        let total: f64 = plan.sums.iter().sum();
+        let all = total + plan.unbounded.iter().sum::<f64>();
         if all > 0.0 && all.is_finite() {
-            for (f, u) in cut.unbounded.iter_mut().zip(&unbounded) {
+            for (f, u) in cut.unbounded.iter_mut().zip(&plan.unbounded) {
                 *f = (u / all) as f32;
             }
         }
         let rebuilt = total > 0.0 && total.is_finite();
         if rebuilt {
-            // The importances at the anchor come from the same table (and
-            // the same function) that sampling modulates with, so at the
-            // anchor the modulated cut is exactly the learned one.
-            let anchor = match (config.modulation, self.importance_table()) {
-                (Modulation::Importance, Some(table)) => cut
-                    .anchor()
-                    .map(|a| (table, FastQuery::new(&ShadingContext::at(a)))),
-                _ => None,
-            };
-            cut.modulated = anchor.is_some();
-            cut.nodes = rebuild(self, &cut.nodes, &sums, total, anchor);
+            cut.modulated = plan.anchor.is_some();
+            let mut sigma = config.sigma;
+            let mut nodes = rebuild(self, &cut.nodes, &plan.sums, total, plan.anchor, sigma);
+            while let Some(cap) = max_nodes.filter(|&cap| nodes.len() > cap && sigma < 1.0) {
+                sigma = if sigma > 0.0 {
+                    (2.0 * sigma).min(1.0)
+                } else {
+                    1.0 / (2 * cap + 2) as f64
+                };
+                nodes = rebuild(self, &cut.nodes, &plan.sums, total, plan.anchor, sigma);
+            }
+            cut.nodes = nodes;
         }
         cut.sums
             .reset(sum_count(cut.nodes.len(), config.unbounded.count));
         cut.anchor.clear();
         rebuilt
     }
+
+    /// What `cut` will hold after [`CutRules::refine`] (which this does
+    /// not change): its node count, the heap bytes per node (the node and
+    /// its two sums) and those it holds whatever its nodes.
+    pub(crate) fn growth(&self, cut: &GuidingCut) -> Growth {
+        let per_sum = cut.sums.bytes_per_sum();
+        let unbounded = cut.unbounded.len();
+        let nodes = match self.plan(cut) {
+            Some(plan) => {
+                let total: f64 = plan.sums.iter().sum();
+                if total > 0.0 && total.is_finite() {
+                    let sigma = self.config().sigma;
+                    rebuild(self, &cut.nodes, &plan.sums, total, plan.anchor, sigma).len()
+                } else {
+                    cut.nodes.len()
+                }
+            }
+            None => cut.nodes.len(),
+        };
+        Growth {
+            fixed: (1 + unbounded) * per_sum + cut.anchor.bytes() + 4 * unbounded,
+            nodes,
+            per_node: CutNode::BYTES + 2 * per_sum,
+        }
+    }
+
+    /// What a refinement of `cut` starts from; `None` when the cut keeps
+    /// accumulating ([`CutConfig::min_splats`](super::CutConfig::min_splats)).
+    fn plan(&self, cut: &GuidingCut) -> Option<Plan<'_>> {
+        let config = self.config();
+        if cut.recorded.get() < u64::from(config.min_splats) {
+            return None;
+        }
+        let clusters = cut.first_unbounded_sum();
+        // The importances at the anchor come from the same table (and
+        // the same function) that sampling modulates with, so at the
+        // anchor the modulated cut is exactly the learned one.
+        let anchor = match (config.modulation, self.importance_table()) {
+            (Modulation::Importance, Some(table)) => cut
+                .anchor()
+                .map(|a| (table, FastQuery::new(&ShadingContext::at(a)))),
+            _ => None,
+        };
+        Some(Plan {
+            sums: (0..clusters).map(|i| cut.sums.get(i)).collect(),
+            unbounded: (clusters..cut.sums.len())
+                .map(|i| cut.sums.get(i))
+                .collect(),
+            anchor,
+        })
+    }
+}
+
+/// The sums a refinement reads, and the anchor it modulates with.
+struct Plan<'a> {
+    sums: Vec<f64>,
+    unbounded: Vec<f64>,
+    anchor: Option<(&'a ImportanceTable, FastQuery)>,
 }
 
 /// Weight of each old cut node's subtree (children follow parents, so one
@@ -179,12 +242,13 @@ fn rebuild<H: LightHierarchy>(
     sums: &[f64],
     total: f64,
     anchor: Option<(&ImportanceTable, FastQuery)>,
+    sigma: f64,
 ) -> Vec<CutNode> {
     let (tree, config, walk) = (guide.light_tree(), guide.config(), guide.walk());
     let (Some(root), Some(root_walk)) = (tree.root(), walk.root()) else {
         return Vec::new();
     };
-    let threshold = config.sigma * total;
+    let threshold = sigma * total;
     let old_weights = subtree_weights(old, sums);
     let mut nodes: Vec<CutNode> = Vec::new();
     let mut stack = vec![Task {

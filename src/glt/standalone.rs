@@ -14,10 +14,10 @@ use crate::light_sampler::{LightId, LightSample, LightSampler};
 use crate::light_tree::LightHierarchy;
 use crate::math::pmf_to_f32;
 use crate::math::{Aabb, Counter};
-use crate::spatial::Jitter;
 use crate::spatial::{
     BinaryTree, CellId, RefineOutcome, SpatialFilter, SpatialTree, jitter_offset, split_threshold,
 };
+use crate::spatial::{Jitter, content_scale};
 use glam::Vec3;
 
 /// Parameters of a [`Glt`]: the cuts' and the spatial tree's.
@@ -30,8 +30,14 @@ pub struct GltConfig {
     /// split halves the count and gives both halves a copy of the cut and
     /// its statistics. Default 12000 (PPG's).
     pub spatial_threshold: f64,
-    /// Cap, in bytes, on spatial tree plus cuts when splitting cells (the
-    /// cuts are charged at their size before the split); `None` for none.
+    /// Cap, in bytes, on the spatial tree plus the cells' cuts (their
+    /// nodes and sums) after every [`Glt::refine`]; `None` for none. Cell
+    /// splits are refused once it is reached (a split is charged the cut
+    /// it copies), then every cut's growth is scaled down by one factor:
+    /// each is rebuilt with a coarser `sigma` until it has at most that
+    /// share of the nodes it would have had (`src/spatial/budget.rs`). The
+    /// cap cannot shrink below what the cells hold whatever their nodes
+    /// (one sum each, the anchor sums).
     pub max_bytes: Option<usize>,
     /// The spatial filter of [`Glt::splat`]. Default
     /// [`SpatialFilter::Nearest`]: the estimate goes to the cell holding
@@ -292,8 +298,17 @@ impl<H: LightHierarchy> Glt<H> {
             |cell| cell.cut.heap_bytes(),
             self.config.max_bytes,
         );
+        // The cuts grow within what the budget leaves (src/spatial/budget.rs).
+        let guide = &self.guide;
+        let cells = self.spatial.data_slice();
+        let scale = content_scale(
+            self.config.max_bytes,
+            self.spatial.bytes(),
+            cells.iter().map(|c| guide.growth(&c.cut)),
+        );
         for cell in self.spatial.data_slice_mut() {
-            self.guide.refine(&mut cell.cut);
+            let cap = scale.and_then(|_| guide.growth(&cell.cut).cap(scale));
+            guide.refine_within(&mut cell.cut, cap);
             cell.splats.reset();
             cell.split_count = 0;
         }

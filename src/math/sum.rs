@@ -95,6 +95,11 @@ impl SumBuffer {
         self.words.len() * core::mem::size_of::<Word>()
     }
 
+    /// Bytes of storage per sum.
+    pub fn bytes_per_sum(&self) -> usize {
+        self.stride * core::mem::size_of::<Word>()
+    }
+
     /// Adds `value` to sum `index`. Values that are negative, NaN or infinite
     /// and indices out of range are ignored (callers validate and count bad
     /// input before this point); returns whether it was added.

@@ -9,9 +9,11 @@
 //! split several levels below a bright leaf.
 
 use super::config::QuadtreeConfig;
+use super::node::NODE_BYTES;
 use super::node::{Link, Node};
 use super::sums::{node_total, subtree_sums};
 use super::tree::DirectionalTree;
+use crate::spatial::Growth;
 use alloc::vec::Vec;
 
 /// Where a node of the new building topology takes its quadrant sums from.
@@ -49,6 +51,14 @@ impl DirectionalTree {
     /// distribution). This differs from PPG, where an empty iteration makes
     /// the distribution uniform.
     pub fn refine(&mut self, config: &QuadtreeConfig) {
+        self.refine_within(config, None);
+    }
+
+    /// [`DirectionalTree::refine`] with at most `max_nodes` nodes (at
+    /// least 1) in the new building topology: while it would have more,
+    /// it is rebuilt with `rho` doubled. Spatial structures use it to keep
+    /// their quadtrees within a memory budget.
+    pub(crate) fn refine_within(&mut self, config: &QuadtreeConfig, max_nodes: Option<usize>) {
         let total = self.building_total();
         if !(total > 0.0 && total.is_finite()) {
             self.sums.clear();
@@ -58,10 +68,43 @@ impl DirectionalTree {
         self.nodes = sampling_nodes(&self.links, &sums);
         self.sampling_total = total;
         self.sampling_depth = self.building_depth;
-        let refined = refine_topology(&self.links, &sums, total, config);
+        let mut rho = config.effective_rho();
+        let mut refined = refine_topology(&self.links, &sums, total, rho, config);
+        while max_nodes.is_some_and(|cap| refined.links.len() > cap.max(1)) && rho < 1.0 {
+            rho = (2.0 * rho).min(1.0);
+            refined = refine_topology(&self.links, &sums, total, rho, config);
+        }
         self.sums.reset(4 * refined.links.len());
         self.links = refined.links;
+        self.links.shrink_to_fit();
         self.building_depth = refined.depth;
+    }
+
+    /// What [`DirectionalTree::refine`] (which this does not change) will
+    /// leave: the heap bytes it cannot choose (the sampling copy, which
+    /// takes the current building topology), the nodes of the new building
+    /// topology, and the bytes each of those costs.
+    pub(crate) fn growth(&self, config: &QuadtreeConfig) -> Growth {
+        let per_node = core::mem::size_of::<Link>() + 4 * self.sums.bytes_per_sum();
+        let total = self.building_total();
+        if !(total > 0.0 && total.is_finite()) {
+            // Kept as it is.
+            let nodes = self.links.len();
+            return Growth {
+                fixed: self.bytes() - core::mem::size_of::<Self>() - nodes * per_node,
+                nodes,
+                per_node,
+            };
+        }
+        let sums = subtree_sums(&self.links, &self.sums);
+        let rho = config.effective_rho();
+        Growth {
+            fixed: self.links.len() * NODE_BYTES,
+            nodes: refine_topology(&self.links, &sums, total, rho, config)
+                .links
+                .len(),
+            per_node,
+        }
     }
 }
 
@@ -90,9 +133,9 @@ pub(crate) fn refine_topology(
     links: &[Link],
     s: &[f64],
     total: f64,
+    rho: f64,
     config: &QuadtreeConfig,
 ) -> Refined {
-    let rho = config.effective_rho();
     let max_depth = config.effective_max_depth();
     // Node i of the new topology comes from queue[i]; children are appended
     // as their parent is processed, so siblings are contiguous.
@@ -153,13 +196,19 @@ mod tests {
     fn one_bright_leaf_splits_by_quarters() {
         let links = [Link::LEAF];
         let s = [0.0, 0.0, 8.0, 0.0];
-        let r = refine_topology(&links, &s, 8.0, &cfg(0.01, 20));
+        let r = refine_topology(
+            &links,
+            &s,
+            8.0,
+            cfg(0.01, 20).effective_rho(),
+            &cfg(0.01, 20),
+        );
         // 1 -> 1/4 -> 1/16 -> 1/64 > 0.01 -> 1/256: levels 2..5 under q 2.
         assert_eq!(r.links.len(), 1 + 1 + 4 + 16 + 64);
         assert_eq!(r.depth, 5);
         assert_eq!(r.links[0].child(2), Some(1));
         assert_eq!(r.sums[4..8], [2.0; 4]);
-        let capped = refine_topology(&links, &s, 8.0, &cfg(0.01, 3));
+        let capped = refine_topology(&links, &s, 8.0, cfg(0.01, 3).effective_rho(), &cfg(0.01, 3));
         assert_eq!(capped.depth, 3);
         assert_eq!(capped.links.len(), 1 + 1 + 4);
     }
@@ -172,7 +221,13 @@ mod tests {
             0.5, 0.0, 0.0, 99.5, // root
             0.125, 0.125, 0.125, 0.125, // under quadrant 0
         ];
-        let r = refine_topology(&links, &s, 100.0, &cfg(0.01, 20));
+        let r = refine_topology(
+            &links,
+            &s,
+            100.0,
+            cfg(0.01, 20).effective_rho(),
+            &cfg(0.01, 20),
+        );
         // Quadrant 0 (share 0.005) merges; quadrant 3 splits.
         assert_eq!(r.links[0].child(0), None);
         assert!(r.links[0].child(3).is_some());
@@ -197,7 +252,13 @@ mod tests {
     fn children_are_contiguous_and_breadth_first() {
         let links = [Link::LEAF];
         let s = [1.0; 4];
-        let r = refine_topology(&links, &s, 4.0, &cfg(0.01, 20));
+        let r = refine_topology(
+            &links,
+            &s,
+            4.0,
+            cfg(0.01, 20).effective_rho(),
+            &cfg(0.01, 20),
+        );
         for (n, link) in r.links.iter().enumerate() {
             for q in 0..4 {
                 if let Some(c) = link.child(q) {

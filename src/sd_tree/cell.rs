@@ -8,6 +8,7 @@ use super::fraction::{FRACTION_SUMS, FractionLearner};
 use crate::math::unit_direction;
 use crate::math::{Accumulation, SumBuffer};
 use crate::quadtree::{DirectionalFilter, DirectionalTree};
+use crate::spatial::Growth;
 use glam::Vec3;
 
 /// Index of the statistical weight in a cell's sums.
@@ -135,14 +136,22 @@ impl SdCell {
     /// for the spatial split rule, optimises the learned fraction, makes
     /// the building quadtree the sampling one (refining its topology) and
     /// zeroes the collected sums.
-    pub(super) fn end_iteration(&mut self, config: &SdTreeConfig) {
+    pub(super) fn end_iteration(&mut self, config: &SdTreeConfig, max_nodes: Option<usize>) {
         self.split_weight = self.stats.get(WEIGHT);
         if config.learn_bsdf_fraction {
             self.learner
                 .optimise(&self.stats, FRACTION_BASE, config.fraction_steps);
         }
-        self.directions.refine(&config.quadtree);
+        self.directions.refine_within(&config.quadtree, max_nodes);
         self.stats.clear();
+    }
+
+    /// What the cell's heap will hold after [`SdCell::end_iteration`]: the
+    /// quadtree's growth, the statistics as fixed bytes.
+    pub(super) fn growth(&self, config: &SdTreeConfig) -> Growth {
+        let mut g = self.directions.growth(&config.quadtree);
+        g.fixed += self.stats.bytes();
+        g
     }
 }
 

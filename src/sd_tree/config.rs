@@ -27,11 +27,14 @@ pub struct SdTreeConfig {
     pub accumulation: Accumulation,
     /// Optional cap on the SD-tree's bytes (spatial tree plus every cell's
     /// quadtrees and sums, as [`SdTreeMemory::total`](super::SdTreeMemory::total)
-    /// counts them): a spatial split that would take the total above it is
-    /// not made. The quadtrees are refined before the spatial splits and are
-    /// not capped (`quadtree.rho` and `max_depth` bound each of them), so
-    /// once cells have stopped splitting their quadtrees can still grow the
-    /// total past the cap; leave headroom for that.
+    /// counts them) after every refine. The quadtrees are refined first,
+    /// their growth scaled down by one factor for all cells when it would
+    /// not fit (each rebuilt with a coarser `rho` until it has at most that
+    /// share of the nodes it would have had; `src/spatial/budget.rs`); then
+    /// a spatial split that would take the total above the cap is not
+    /// made. The sampling copy a refine makes is the building topology of
+    /// the iteration before (already within the cap then), so the cap
+    /// binds the memory one iteration after it is reached.
     pub max_bytes: Option<usize>,
     /// The BSDF sampling fraction `s` (probability of sampling the BSDF
     /// rather than the guiding distribution). Fixed when

@@ -2,30 +2,42 @@
 
 use super::state::SdState;
 use super::{SdCell, SdTree};
-use crate::spatial::{BinaryTree, RefineOutcome};
+use crate::spatial::{BinaryTree, Growth, RefineOutcome, content_scale};
 
 impl SdState {
     /// Ends iteration `k = self.iteration` over the cells of `tree`: every
     /// cell's [`SdCell::end_iteration`] and then `per_cell` (what else the
-    /// cell holds), then PPG's spatial split rule on the collected weights
-    /// within `max_bytes`, counting `heap_bytes` per cell. Returns what the
-    /// spatial pass did.
+    /// cell holds, whose growth `other` reports), then PPG's spatial split
+    /// rule on the collected weights within `max_bytes`, counting
+    /// `heap_bytes` per cell. Within `max_bytes` the quadtrees and the
+    /// other content grow by one shared factor (`src/spatial/budget.rs`),
+    /// passed to `per_cell`. Returns what the spatial pass did.
     pub(crate) fn refine<C: AsRef<SdCell> + AsMut<SdCell> + Clone>(
         &mut self,
         tree: &mut BinaryTree<C>,
-        mut per_cell: impl FnMut(&mut C),
+        other: impl Fn(&C) -> Growth,
+        mut per_cell: impl FnMut(&mut C, Option<f64>),
         heap_bytes: impl FnMut(&C) -> usize,
     ) -> RefineOutcome {
+        let config = self.config;
+        let scale = content_scale(
+            config.max_bytes,
+            tree.bytes(),
+            tree.data_slice()
+                .iter()
+                .flat_map(|c| [c.as_ref().growth(&config), other(c)]),
+        );
         for cell in tree.data_slice_mut() {
-            cell.as_mut().end_iteration(&self.config);
-            per_cell(cell);
+            let cap = scale.and_then(|_| cell.as_ref().growth(&config).cap(scale));
+            cell.as_mut().end_iteration(&config, cap);
+            per_cell(cell, scale);
         }
         let outcome = tree.split_by_weight(
-            self.config.split_threshold(self.iteration),
+            config.split_threshold(self.iteration),
             |cell| cell.as_ref().split_weight,
             |cell| cell.as_mut().split_weight *= 0.5,
             heap_bytes,
-            self.config.max_bytes,
+            config.max_bytes,
         );
         for cell in tree.data_slice_mut() {
             cell.as_mut().split_weight = 0.0;
@@ -43,7 +55,11 @@ impl SdTree {
     /// [`SdTreeConfig::max_bytes`](super::SdTreeConfig::max_bytes)), then
     /// zeroes the collected sums. Returns what the spatial pass did.
     pub fn refine(&mut self) -> RefineOutcome {
-        self.state
-            .refine(&mut self.tree, |_| {}, |cell| cell.heap_bytes())
+        self.state.refine(
+            &mut self.tree,
+            |_| Growth::default(),
+            |_, _| {},
+            |cell| cell.heap_bytes(),
+        )
     }
 }

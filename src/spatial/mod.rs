@@ -36,6 +36,7 @@
 //! ```
 
 mod binary_tree;
+mod budget;
 mod cell_id;
 mod filter;
 mod jitter;
@@ -46,6 +47,7 @@ mod split_rule;
 mod tree_trait;
 
 pub use binary_tree::BinaryTree;
+pub(crate) use budget::{Growth, content_scale};
 pub use cell_id::{CellId, CellIds};
 pub use filter::SpatialFilter;
 pub(crate) use jitter::jitter_offset;
