@@ -5,8 +5,7 @@
 use glam::{Vec2, Vec3};
 use guiding::math::{Accumulation, canonical_to_dir, dir_to_canonical};
 use guiding::quadtree::{
-    DEFAULT_UNIFORM_FRACTION, DirectionalFilter, DirectionalTree, NODE_BYTES, QuadLeaf,
-    QuadtreeConfig, UNIFORM_PDF,
+    DirectionalFilter, DirectionalTree, NODE_BYTES, QuadLeaf, QuadtreeConfig, UNIFORM_PDF,
 };
 use rand_core::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -572,7 +571,7 @@ fn pdf_is_positive_where_nothing_was_learned() {
         }
         tree.refine(&QuadtreeConfig::default());
     }
-    let floor = DEFAULT_UNIFORM_FRACTION * UNIFORM_PDF;
+    let floor = DirectionalTree::DEFAULT_UNIFORM_FRACTION * UNIFORM_PDF;
     let dark = tree.pdf(-Vec3::Z);
     assert!((dark - floor).abs() <= 1e-6 * floor, "{dark} vs {floor}");
     tree.set_uniform_fraction(1.0);

@@ -3,8 +3,7 @@
 //! simulation.
 
 use guiding::schedule::{
-    InverseVarianceCombiner, Iterations, MAX_COMBINED, PassStats, next_iteration,
-    next_iteration_by_time,
+    InverseVarianceCombiner, Iterations, PassStats, next_iteration, next_iteration_by_time,
 };
 use rand_core::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -159,7 +158,7 @@ fn weights_are_inverse_variance_and_sum_to_one() {
     for v in 1..=6 {
         c.push_image(&[v as f32], Some(1.0), 1);
     }
-    assert_eq!(c.len(), MAX_COMBINED);
+    assert_eq!(c.len(), InverseVarianceCombiner::MAX_COMBINED);
     assert_eq!(c.weights(), [0.25; 4]);
     assert_eq!(c.combine(), [(3.0 + 4.0 + 5.0 + 6.0) / 4.0]);
 

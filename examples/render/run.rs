@@ -12,8 +12,7 @@ use glam::Vec3;
 use guiding::field::GuidingField;
 use guiding::glt::Glt;
 use guiding::schedule::{
-    InverseVarianceCombiner, Iteration, MAX_COMBINED, PassStats, next_iteration,
-    next_iteration_by_time,
+    InverseVarianceCombiner, Iteration, PassStats, next_iteration, next_iteration_by_time,
 };
 use guiding::sd_tree::SdTree;
 use guiding::{LightSampler, LightTree};
@@ -238,7 +237,7 @@ pub fn render_trained<'a>(
             f64::NAN
         };
         combiner.push_stats(&stats);
-        if history.len() == MAX_COMBINED {
+        if history.len() == InverseVarianceCombiner::MAX_COMBINED {
             history.pop_front();
         }
         history.push_back(Done { stats, mean_var });

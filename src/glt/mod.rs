@@ -49,6 +49,5 @@ pub use config::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
 pub use cut::{CutError, CutMemory, GuidingCut};
 pub use cut_node::{CutNode, Slot};
 pub use cut_rules::CutRules;
-pub use sampling::CutSampler;
 pub use splat::SplatOutcome;
 pub use standalone::{Glt, GltCell, GltConfig, GltMemory, GltVertex};

@@ -486,14 +486,13 @@ impl<H: LightHierarchy> CutRules<H> {
 
     /// `cut` as a [`LightSampler`] (for one cell, or a renderer that keeps
     /// its own spatial structure).
-    pub fn sampler<'b>(&'b self, cut: &'b GuidingCut) -> CutSampler<'b, H> {
+    pub fn sampler<'b>(&'b self, cut: &'b GuidingCut) -> impl LightSampler + Copy + 'b {
         CutSampler { guide: self, cut }
     }
 }
 
 /// One cell's cut with its [`CutRules`], as a [`LightSampler`].
-#[derive(Debug)]
-pub struct CutSampler<'b, H: LightHierarchy> {
+struct CutSampler<'b, H: LightHierarchy> {
     guide: &'b CutRules<H>,
     cut: &'b GuidingCut,
 }

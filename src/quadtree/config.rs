@@ -10,21 +10,21 @@ pub const UNIFORM_PDF: f32 = 1.0 / SPHERE_MAP_JACOBIAN;
 /// [`QuadtreeConfig::max_depth`] says: a cell at level 24 is `2^-24` wide,
 /// about the resolution of an `f32` direction mapped to canonical space, so
 /// deeper cells could not be told apart by any direction.
-pub const MAX_DEPTH: u32 = 24;
+pub(crate) const MAX_DEPTH: u32 = 24;
 
 /// The smallest split threshold used; a smaller (or non-positive) `rho` is
 /// raised to this. A tree has at most about `max_depth / rho` nodes, so this
 /// bounds memory for a mistaken configuration.
-pub const MIN_RHO: f32 = 1.0e-6;
+pub(crate) const MIN_RHO: f32 = 1.0e-6;
 
 /// The default weight of the uniform part of the density (the defensive
 /// mixture). It costs one sample in a thousand and caps the sampling weight
 /// `1 / pdf` at `4 pi / 0.001` where nothing was learned.
-pub const DEFAULT_UNIFORM_FRACTION: f32 = 1.0e-3;
+pub(crate) const DEFAULT_UNIFORM_FRACTION: f32 = 1.0e-3;
 
 /// The smallest accepted uniform fraction: it keeps the pdf of every valid
 /// direction positive in `f32`.
-pub const MIN_UNIFORM_FRACTION: f32 = 1.0e-6;
+pub(crate) const MIN_UNIFORM_FRACTION: f32 = 1.0e-6;
 
 /// How [`DirectionalTree::refine`](super::DirectionalTree::refine) reshapes
 /// the building copy.
@@ -33,11 +33,11 @@ pub struct QuadtreeConfig {
     /// A quadrant whose share of the tree's total exceeds `rho` is split
     /// (becomes a node); a subtree whose share is at most `rho` is merged
     /// into one leaf. Default `0.01` (PPG). In `[MIN_RHO, 1]`
-    /// ([`MIN_RHO`]).
+    /// ([`QuadtreeConfig::MIN_RHO`]).
     pub rho: f32,
     /// The deepest node level (the root is level 1, so leaves are at least
     /// `2^-max_depth` wide). Default `20` (PPG). In `1..=MAX_DEPTH`
-    /// ([`MAX_DEPTH`]).
+    /// ([`QuadtreeConfig::MAX_DEPTH`]).
     pub max_depth: u32,
 }
 
@@ -51,6 +51,16 @@ impl Default for QuadtreeConfig {
 }
 
 impl QuadtreeConfig {
+    /// The deepest node level a tree refines to, whatever `max_depth`
+    /// says: a cell at level 24 is `2^-24` wide, about the resolution of an
+    /// `f32` direction mapped to canonical space, so deeper cells could not
+    /// be told apart by any direction.
+    pub const MAX_DEPTH: u32 = MAX_DEPTH;
+
+    /// The smallest split threshold accepted. A tree has at most about
+    /// `max_depth / rho` nodes, so this bounds memory.
+    pub const MIN_RHO: f32 = MIN_RHO;
+
     /// Checks `rho` in `[MIN_RHO, 1]` and `max_depth` in `1..=MAX_DEPTH`.
     /// A [`DirectionalTree`](super::DirectionalTree) refined with an
     /// unchecked configuration uses the nearest valid values.
@@ -70,7 +80,7 @@ impl QuadtreeConfig {
         )
     }
 
-    /// `rho` as used: at least [`MIN_RHO`].
+    /// `rho` as used: at least [`QuadtreeConfig::MIN_RHO`].
     pub(crate) fn effective_rho(&self) -> f64 {
         if self.rho >= MIN_RHO {
             self.rho as f64
@@ -79,7 +89,7 @@ impl QuadtreeConfig {
         }
     }
 
-    /// `max_depth` as used: in `1..=MAX_DEPTH`.
+    /// `max_depth` as used: in `1..=`[`QuadtreeConfig::MAX_DEPTH`].
     pub(crate) fn effective_max_depth(&self) -> u32 {
         self.max_depth.clamp(1, MAX_DEPTH)
     }

@@ -34,7 +34,7 @@
 //! `4 * sum[q] / (sum of the node's four sums)`, per unit canonical area,
 //! divided by the Jacobian `4 pi`. It is mixed with a small uniform part
 //! ([`DirectionalTree::uniform_fraction`], default
-//! [`DEFAULT_UNIFORM_FRACTION`]) so the pdf is never 0 for a valid direction,
+//! [`DirectionalTree::DEFAULT_UNIFORM_FRACTION`]) so the pdf is never 0 for a valid direction,
 //! even where nothing was learned. A tree that has never learned anything
 //! (or learned only zeros) is exactly uniform, `1 / (4 pi)`.
 
@@ -48,10 +48,7 @@ mod splat;
 mod sums;
 mod tree;
 
-pub use config::{
-    DEFAULT_UNIFORM_FRACTION, DirectionalFilter, MAX_DEPTH, MIN_RHO, MIN_UNIFORM_FRACTION,
-    QuadtreeConfig, UNIFORM_PDF,
-};
+pub use config::{DirectionalFilter, QuadtreeConfig, UNIFORM_PDF};
 pub use leaves::QuadLeaf;
 pub use node::NODE_BYTES;
 pub use tree::DirectionalTree;

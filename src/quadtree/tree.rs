@@ -47,6 +47,16 @@ pub struct DirectionalTree {
 }
 
 impl DirectionalTree {
+    /// The default weight of the uniform part of the density (the
+    /// defensive mixture). It costs one sample in a thousand and caps the
+    /// sampling weight `1 / pdf` at `4 pi / 0.001` where nothing was
+    /// learned.
+    pub const DEFAULT_UNIFORM_FRACTION: f32 = DEFAULT_UNIFORM_FRACTION;
+
+    /// The smallest uniform fraction: it keeps the pdf of every valid
+    /// direction positive in `f32`.
+    pub const MIN_UNIFORM_FRACTION: f32 = MIN_UNIFORM_FRACTION;
+
     /// An empty tree: a root whose four quadrants are leaves, sampling
     /// uniformly (pdf `1 / (4 pi)`), collecting sums in `mode`.
     pub fn new(mode: Accumulation) -> Self {
@@ -68,7 +78,7 @@ impl DirectionalTree {
     }
 
     /// Sets the weight of the uniform part, clamped to
-    /// `[MIN_UNIFORM_FRACTION, 1]` (NaN gives the default). It applies to
+    /// `[`[`DirectionalTree::MIN_UNIFORM_FRACTION`]`, 1]` (NaN gives the default). It applies to
     /// the current sampling copy at once.
     pub fn set_uniform_fraction(&mut self, fraction: f32) {
         let f = if fraction.is_nan() {

@@ -5,9 +5,6 @@ use alloc::collections::VecDeque;
 use alloc::vec;
 use alloc::vec::Vec;
 
-/// How many of the latest iterations are combined (PPG: four).
-pub const MAX_COMBINED: usize = 4;
-
 #[derive(Clone, Debug)]
 struct Entry {
     image: Vec<f64>,
@@ -15,7 +12,7 @@ struct Entry {
     passes: u64,
 }
 
-/// Blends the last [`MAX_COMBINED`] iteration images with one weight each,
+/// Blends the last [`InverseVarianceCombiner::MAX_COMBINED`] iteration images with one weight each,
 /// proportional to the inverse of the image's estimated variance.
 ///
 /// Weights sum to 1. Iterations without a variance estimate (one pass) get
@@ -28,6 +25,9 @@ pub struct InverseVarianceCombiner {
 }
 
 impl InverseVarianceCombiner {
+    /// How many of the latest iterations are combined (PPG: four).
+    pub const MAX_COMBINED: usize = 4;
+
     /// An empty combiner.
     pub fn new() -> Self {
         Self::default()
@@ -35,7 +35,7 @@ impl InverseVarianceCombiner {
 
     /// Adds an iteration's image with its variance estimate (of the image
     /// averaged over elements; `None` if unknown) and pass count. The oldest
-    /// is dropped beyond [`MAX_COMBINED`]. A negative or non-finite variance
+    /// is dropped beyond [`InverseVarianceCombiner::MAX_COMBINED`]. A negative or non-finite variance
     /// counts as unknown.
     pub fn push_image(&mut self, image: &[f32], variance: Option<f64>, passes: u64) {
         self.push(Entry {
@@ -57,13 +57,13 @@ impl InverseVarianceCombiner {
 
     fn push(&mut self, mut entry: Entry) {
         entry.variance = entry.variance.filter(|v| *v >= 0.0 && v.is_finite());
-        if self.entries.len() == MAX_COMBINED {
+        if self.entries.len() == Self::MAX_COMBINED {
             self.entries.pop_front();
         }
         self.entries.push_back(entry);
     }
 
-    /// Iterations held (at most [`MAX_COMBINED`]).
+    /// Iterations held (at most [`InverseVarianceCombiner::MAX_COMBINED`]).
     pub fn len(&self) -> usize {
         self.entries.len()
     }

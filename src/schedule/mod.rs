@@ -79,6 +79,6 @@ mod combine;
 mod iterations;
 mod pass_stats;
 
-pub use combine::{InverseVarianceCombiner, MAX_COMBINED};
+pub use combine::InverseVarianceCombiner;
 pub use iterations::{Iteration, Iterations, next_iteration, next_iteration_by_time};
 pub use pass_stats::PassStats;

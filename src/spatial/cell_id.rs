@@ -17,7 +17,7 @@ impl CellId {
 
 /// Iterator over all cells `0..cell_count()` in number order.
 #[derive(Clone, Debug)]
-pub struct CellIds(pub(crate) Range<u32>);
+pub(crate) struct CellIds(pub(crate) Range<u32>);
 
 impl Iterator for CellIds {
     type Item = CellId;

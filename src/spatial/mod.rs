@@ -48,7 +48,7 @@ mod tree_trait;
 
 pub use binary_tree::BinaryTree;
 pub(crate) use budget::{Growth, content_scale};
-pub use cell_id::{CellId, CellIds};
+pub use cell_id::CellId;
 pub use filter::SpatialFilter;
 pub(crate) use jitter::jitter_offset;
 pub use jitter::{Jitter, JitterNumbers};

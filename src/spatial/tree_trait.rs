@@ -1,6 +1,7 @@
 //! The interface every spatial subdivision offers.
 
-use super::{CellId, CellIds};
+use super::CellId;
+use super::cell_id::CellIds;
 use crate::math::Aabb;
 use glam::Vec3;
 
@@ -38,8 +39,12 @@ pub trait SpatialTree {
     /// region.
     fn visit_overlapping(&self, region: &Aabb, visit: &mut dyn FnMut(CellId));
 
-    /// All cells in number order.
-    fn cells(&self) -> CellIds {
+    /// All cells in number order (through `dyn SpatialTree`, count
+    /// `0..cell_count()` instead).
+    fn cells(&self) -> impl ExactSizeIterator<Item = CellId> + DoubleEndedIterator
+    where
+        Self: Sized,
+    {
         let n = u32::try_from(self.cell_count()).unwrap_or(u32::MAX);
         CellIds(0..n)
     }
