@@ -90,6 +90,34 @@ impl DropCounters {
             *c.get_mut() = 0;
         }
     }
+
+    /// Writes the six counts.
+    pub(crate) fn write(&self, w: &mut crate::persist::Writer) {
+        for c in &self.counts {
+            #[allow(clippy::useless_conversion, clippy::unnecessary_cast)]
+            w.u64(c.load(Relaxed) as u64);
+        }
+    }
+
+    /// Reads what [`DropCounters::write`] wrote.
+    pub(crate) fn read(
+        r: &mut crate::persist::Reader<'_>,
+    ) -> Result<Self, crate::persist::LoadError> {
+        let s = Self::default();
+        for c in &s.counts {
+            #[allow(clippy::useless_conversion, clippy::unnecessary_cast)]
+            c.store(r.u64("dropped splats")? as _, Relaxed);
+        }
+        Ok(s)
+    }
+
+    /// Adds `other`'s counts.
+    pub(crate) fn merge(&mut self, other: &Self) {
+        for (a, b) in self.counts.iter_mut().zip(&other.counts) {
+            let c = a.get_mut();
+            *c = c.wrapping_add(b.load(Relaxed));
+        }
+    }
 }
 
 impl Clone for DropCounters {

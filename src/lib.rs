@@ -74,6 +74,7 @@ pub mod light_tree;
 pub mod math;
 pub mod mis;
 pub mod path_recorder;
+pub mod persist;
 pub mod quadtree;
 pub mod schedule;
 pub mod sd_tree;
@@ -99,4 +100,5 @@ pub use light_sampler::{
 };
 pub use light_tree::{LightHierarchy, LightTree};
 pub use path_recorder::PathRecorder;
+pub use persist::LoadError;
 pub use strategy::Strategy;

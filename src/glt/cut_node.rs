@@ -55,6 +55,17 @@ impl CutNode {
         }
     }
 
+    /// The stored fields (the save format).
+    pub(crate) fn raw(&self) -> (f32, [u32; 2]) {
+        (self.p_left, self.slots)
+    }
+
+    /// A node from [`CutNode::raw`]'s fields (checked by the cut's
+    /// `check`).
+    pub(crate) fn from_raw(p_left: f32, slots: [u32; 2]) -> Self {
+        Self { p_left, slots }
+    }
+
     /// The learned probability of the left side.
     #[inline]
     pub fn p_left(&self) -> f32 {

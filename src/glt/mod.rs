@@ -39,6 +39,7 @@ mod config;
 mod cut;
 mod cut_node;
 mod cut_rules;
+mod persist;
 mod refine;
 mod sampling;
 mod splat;

@@ -74,11 +74,11 @@ impl Default for GltConfig {
 /// received this iteration (for spatial refinement).
 #[derive(Clone, Debug)]
 pub struct GltCell {
-    cut: GuidingCut,
-    splats: Counter,
+    pub(super) cut: GuidingCut,
+    pub(super) splats: Counter,
     /// The count the spatial split rule sees during `refine` (halved at
     /// each split).
-    split_count: u64,
+    pub(super) split_count: u64,
 }
 
 impl AsRef<GuidingCut> for GltCell {
@@ -147,11 +147,11 @@ impl GltMemory {
 /// borrowed (`Glt<&LightTree>`).
 #[derive(Clone, Debug)]
 pub struct Glt<H: LightHierarchy> {
-    guide: CutRules<H>,
-    config: GltConfig,
-    spatial: BinaryTree<GltCell>,
-    iteration: u32,
-    dropped: DropCounters,
+    pub(super) guide: CutRules<H>,
+    pub(super) config: GltConfig,
+    pub(super) spatial: BinaryTree<GltCell>,
+    pub(super) iteration: u32,
+    pub(super) dropped: DropCounters,
 }
 
 impl<H: LightHierarchy> Glt<H> {

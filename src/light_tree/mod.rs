@@ -10,6 +10,7 @@ mod error;
 mod hierarchy;
 mod node;
 mod path;
+mod persist;
 mod tree;
 
 pub use build::BuildHeuristic;

@@ -97,6 +97,38 @@ impl LightNode {
         self.link & LEAF_BIT != 0
     }
 
+    /// The node as eight `u32` words, in an order and packing that do not
+    /// depend on the platform (the save format).
+    pub(crate) fn words(&self) -> [u32; 8] {
+        let b = &self.bounds;
+        let pair = |lo: u16, hi: u16| u32::from(lo) | (u32::from(hi) << 16);
+        [
+            pair(b[0], b[1]),
+            pair(b[2], b[3]),
+            pair(b[4], b[5]),
+            pair(self.cos_theta_o, self.cos_theta_e),
+            self.axis,
+            self.power,
+            self.link,
+            self.parent,
+        ]
+    }
+
+    /// The node from [`LightNode::words`]'s words.
+    pub(crate) fn from_words(w: [u32; 8]) -> Self {
+        let lo = |x: u32| x as u16;
+        let hi = |x: u32| (x >> 16) as u16;
+        Self {
+            bounds: [lo(w[0]), hi(w[0]), lo(w[1]), hi(w[1]), lo(w[2]), hi(w[2])],
+            cos_theta_o: lo(w[3]),
+            cos_theta_e: hi(w[3]),
+            axis: w[4],
+            power: w[5],
+            link: w[6],
+            parent: w[7],
+        }
+    }
+
     #[inline]
     pub(crate) fn link(&self) -> u32 {
         self.link

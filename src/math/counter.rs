@@ -34,6 +34,20 @@ impl Counter {
     pub fn reset(&mut self) {
         *self.0.get_mut() = 0;
     }
+
+    /// A counter at `n` (wrapped to 32 bits where the counter is).
+    pub(crate) fn with(n: u64) -> Self {
+        #[allow(clippy::useless_conversion, clippy::unnecessary_cast)]
+        Self(Atomic::new(n as _))
+    }
+
+    /// Adds `other`'s count (merging two structures' statistics).
+    pub(crate) fn merge(&mut self, other: &Self) {
+        #[allow(clippy::useless_conversion, clippy::unnecessary_cast)]
+        let n = other.0.load(Relaxed) as _;
+        let c = self.0.get_mut();
+        *c = c.wrapping_add(n);
+    }
 }
 
 impl Clone for Counter {

@@ -150,6 +150,96 @@ impl SumBuffer {
     }
 }
 
+impl SumBuffer {
+    /// Bytes one exact sum takes in the save format: the fixed-point
+    /// integer, little-endian, whatever the word size.
+    const SAVED_EXACT_BYTES: usize = (EXACT_BITS / 8) as usize;
+
+    /// Writes the mode, the count and every sum (`f64` bits, or the exact
+    /// integer's 48 bytes), so a reload holds the same values bit for bit.
+    pub(crate) fn write(&self, w: &mut crate::persist::Writer) {
+        let exact = self.mode() == Accumulation::Deterministic;
+        w.bool(exact);
+        w.len(self.len());
+        if !exact {
+            for i in 0..self.len() {
+                w.f64(self.get(i));
+            }
+            return;
+        }
+        for word in &self.words {
+            w.bytes(&word.load(Relaxed).to_le_bytes());
+        }
+    }
+
+    /// Reads what [`SumBuffer::write`] wrote: `expected` sums in `mode`
+    /// (fast sums must be finite and non-negative; any exact integer is a
+    /// valid sum).
+    pub(crate) fn read(
+        r: &mut crate::persist::Reader<'_>,
+        field: &'static str,
+        mode: Accumulation,
+        expected: usize,
+    ) -> Result<Self, crate::persist::LoadError> {
+        use crate::persist::Reader;
+        let at = r.offset();
+        let exact = r.bool(field)?;
+        let target = Self::new(0, mode);
+        if exact != (target.mode() == Accumulation::Deterministic) {
+            return Err(Reader::invalid(field, at));
+        }
+        let item = if exact { Self::SAVED_EXACT_BYTES } else { 8 };
+        let len = r.len(field, item)?;
+        if len != expected {
+            return Err(Reader::invalid(field, at));
+        }
+        let mut words = Vec::with_capacity(len * target.stride);
+        if exact {
+            const BYTES: usize = core::mem::size_of::<Raw>();
+            for _ in 0..len * target.stride {
+                let b = r.bytes(BYTES, field)?;
+                let mut a = [0u8; BYTES];
+                a.copy_from_slice(b);
+                words.push(Word::new(Raw::from_le_bytes(a)));
+            }
+        } else {
+            #[cfg(target_has_atomic = "64")]
+            for _ in 0..len {
+                let x = r.check(field, Reader::f64, |x| *x >= 0.0 && x.is_finite())?;
+                words.push(Word::new(x.to_bits()));
+            }
+        }
+        Ok(Self {
+            words,
+            stride: target.stride,
+        })
+    }
+
+    /// Adds every sum of `other` (same length and mode) to this one's:
+    /// exactly in deterministic mode (integer addition with carries), in
+    /// `f64` otherwise. False, and nothing changed, when they differ.
+    pub(crate) fn merge(&mut self, other: &Self) -> bool {
+        if self.words.len() != other.words.len() || self.stride != other.stride {
+            return false;
+        }
+        #[cfg(target_has_atomic = "64")]
+        if self.stride == 1 {
+            for (a, b) in self.words.iter_mut().zip(&other.words) {
+                let sum = f64::from_bits(*a.get_mut()) + f64::from_bits(b.load(Relaxed));
+                *a.get_mut() = sum.to_bits();
+            }
+            return true;
+        }
+        for i in 0..self.len() {
+            let words = &self.words[i * self.stride..(i + 1) * self.stride];
+            for k in 0..self.stride {
+                add_word(words, k, other.words[i * self.stride + k].load(Relaxed));
+            }
+        }
+        true
+    }
+}
+
 impl Clone for SumBuffer {
     fn clone(&self) -> Self {
         Self {

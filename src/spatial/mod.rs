@@ -41,6 +41,7 @@ mod cell_id;
 mod filter;
 mod jitter;
 mod overlap;
+mod persist;
 mod refine;
 mod root_cube;
 mod split_rule;

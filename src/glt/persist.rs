@@ -1,0 +1,292 @@
+//! Saving and loading the GLT's configuration, its cuts and the standalone
+//! [`Glt`] (`src/persist/mod.rs` has the header, `docs/format.md` the
+//! layout); merging two GLTs' statistics.
+
+use super::config::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
+use super::cut::{GuidingCut, anchor_sums, sum_count};
+use super::cut_node::CutNode;
+use super::cut_rules::CutRules;
+use super::standalone::{Glt, GltCell, GltConfig};
+use crate::dropped::DropCounters;
+use crate::light_sampler::UnboundedLights;
+use crate::light_tree::LightHierarchy;
+use crate::math::{Accumulation, Counter, SumBuffer};
+use crate::persist::{Kind, LoadError, Reader, Writer, fingerprint};
+use crate::spatial::SpatialFilter;
+use alloc::vec::Vec;
+
+/// A field's `ConfigError` as a load error at `offset`.
+pub(crate) fn config_error(e: crate::ConfigError, offset: usize) -> LoadError {
+    Reader::invalid(e.field, offset)
+}
+
+/// `x` as one byte by its position in `all`.
+fn tag<T: PartialEq + Copy>(all: &[T], x: T) -> u8 {
+    all.iter().position(|&a| a == x).unwrap_or(0) as u8
+}
+
+/// The variant at position `byte` of `all`.
+pub(crate) fn untag<T: Copy>(
+    r: &mut Reader<'_>,
+    field: &'static str,
+    all: &[T],
+) -> Result<T, LoadError> {
+    let at = r.offset();
+    let b = r.u8(field)?;
+    all.get(usize::from(b))
+        .copied()
+        .ok_or_else(|| Reader::invalid(field, at))
+}
+
+pub(crate) const ACCUMULATION: [Accumulation; 2] =
+    [Accumulation::Fast, Accumulation::Deterministic];
+pub(crate) const FILTERS: [SpatialFilter; 3] = [
+    SpatialFilter::Nearest,
+    SpatialFilter::StochasticBox,
+    SpatialFilter::Box,
+];
+
+impl CutConfig {
+    pub(crate) fn write(&self, w: &mut Writer) {
+        w.f64(self.sigma);
+        w.f64(self.alpha);
+        w.u8(tag(
+            &[BelowCut::Power, BelowCut::Importance],
+            self.below_cut,
+        ));
+        w.u8(tag(
+            &[Modulation::None, Modulation::Importance],
+            self.modulation,
+        ));
+        w.u8(tag(&[Prior::Power, Prior::Importance], self.prior));
+        w.u8(tag(
+            &[SplitPrior::Half, SplitPrior::Power],
+            self.split_prior,
+        ));
+        w.u32(self.unbounded.count);
+        w.f64(self.unbounded.probability);
+        w.u8(tag(&ACCUMULATION, self.accumulation));
+        w.u32(self.min_splats);
+    }
+
+    pub(crate) fn read(r: &mut Reader<'_>) -> Result<Self, LoadError> {
+        let at = r.offset();
+        let config = Self {
+            sigma: r.f64("cut config: sigma")?,
+            alpha: r.f64("cut config: alpha")?,
+            below_cut: untag(
+                r,
+                "cut config: below_cut",
+                &[BelowCut::Power, BelowCut::Importance],
+            )?,
+            modulation: untag(
+                r,
+                "cut config: modulation",
+                &[Modulation::None, Modulation::Importance],
+            )?,
+            prior: untag(r, "cut config: prior", &[Prior::Power, Prior::Importance])?,
+            split_prior: untag(
+                r,
+                "cut config: split_prior",
+                &[SplitPrior::Half, SplitPrior::Power],
+            )?,
+            unbounded: UnboundedLights {
+                count: r.u32("cut config: unbounded count")?,
+                probability: r.f64("cut config: unbounded probability")?,
+            },
+            accumulation: untag(r, "cut config: accumulation", &ACCUMULATION)?,
+            min_splats: r.u32("cut config: min_splats")?,
+        };
+        config.validate().map_err(|e| config_error(e, at))?;
+        Ok(config)
+    }
+}
+
+impl GltConfig {
+    fn write(&self, w: &mut Writer) {
+        self.cut.write(w);
+        w.f64(self.spatial_threshold);
+        w.bool(self.max_bytes.is_some());
+        w.u64(self.max_bytes.unwrap_or(0) as u64);
+        w.u8(tag(&FILTERS, self.filter));
+    }
+
+    fn read(r: &mut Reader<'_>) -> Result<Self, LoadError> {
+        let at = r.offset();
+        let cut = CutConfig::read(r)?;
+        let spatial_threshold = r.f64("glt config: spatial_threshold")?;
+        let capped = r.bool("glt config: max_bytes")?;
+        let bytes = r.u64("glt config: max_bytes")?;
+        let config = Self {
+            cut,
+            spatial_threshold,
+            max_bytes: capped.then_some(usize::try_from(bytes).unwrap_or(usize::MAX)),
+            filter: untag(r, "glt config: filter", &FILTERS)?,
+        };
+        config.validate().map_err(|e| config_error(e, at))?;
+        Ok(config)
+    }
+}
+
+impl GuidingCut {
+    pub(crate) fn write(&self, w: &mut Writer) {
+        w.len(self.nodes.len());
+        for n in &self.nodes {
+            let (p, [a, b]) = n.raw();
+            w.f32(p);
+            w.u32(a);
+            w.u32(b);
+        }
+        self.sums.write(w);
+        w.len(self.unbounded.len());
+        for &f in self.unbounded.iter() {
+            w.f32(f);
+        }
+        w.u64(self.recorded.get());
+        self.anchor.write(w);
+        w.bool(self.modulated);
+    }
+
+    /// Reads a cut of `rules`' light tree and configuration, checked
+    /// ([`GuidingCut::check`], sum counts, fractions in `[0, 1]`).
+    pub(crate) fn read<H: LightHierarchy>(
+        r: &mut Reader<'_>,
+        rules: &CutRules<H>,
+    ) -> Result<Self, LoadError> {
+        let config = rules.config();
+        let at = r.offset();
+        let count = r.len("cut: node count", 12)?;
+        let mut nodes = Vec::with_capacity(count);
+        for _ in 0..count {
+            let p = r.f32("cut: p_left")?;
+            let a = r.u32("cut: slot")?;
+            let b = r.u32("cut: slot")?;
+            nodes.push(CutNode::from_raw(p, [a, b]));
+        }
+        let k = config.unbounded.count;
+        let sums = SumBuffer::read(r, "cut: sums", config.accumulation, sum_count(count, k))?;
+        let fractions_at = r.offset();
+        let n = r.len("cut: unbounded fractions", 4)?;
+        if n != k as usize {
+            return Err(Reader::invalid("cut: unbounded fractions", fractions_at));
+        }
+        let mut unbounded = Vec::with_capacity(n);
+        for _ in 0..n {
+            unbounded.push(r.check("cut: unbounded fraction", Reader::f32, |f| {
+                (0.0..=1.0).contains(f)
+            })?);
+        }
+        let recorded = Counter::with(r.u64("cut: recorded")?);
+        let anchor = SumBuffer::read(r, "cut: anchor", config.accumulation, anchor_sums(config))?;
+        let modulated = r.bool("cut: modulated")?;
+        let cut = Self {
+            nodes,
+            sums,
+            unbounded: unbounded.into_boxed_slice(),
+            recorded,
+            anchor,
+            modulated,
+        };
+        cut.check(rules.light_tree())
+            .map_err(|_| Reader::invalid("cut: nodes", at))?;
+        Ok(cut)
+    }
+
+    /// Adds `other`'s accumulating state (same topology) to this cut's.
+    pub(crate) fn merge(&mut self, other: &Self) -> bool {
+        if self.nodes != other.nodes || self.unbounded != other.unbounded {
+            return false;
+        }
+        if !(self.sums.merge(&other.sums) && self.anchor.merge(&other.anchor)) {
+            return false;
+        }
+        self.recorded.merge(&other.recorded);
+        true
+    }
+}
+
+impl<H: LightHierarchy> Glt<H> {
+    /// The learned state as bytes: a header, the light hierarchy's
+    /// [`fingerprint`](crate::persist::fingerprint), the configuration, the
+    /// iteration, the drop counts and every cell (cut, sums, counts).
+    /// Accumulating sums are included, so a saved GLT can be merged or go
+    /// on learning.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer::default();
+        w.u64(fingerprint(self.light_tree()));
+        self.config.write(&mut w);
+        w.u32(self.iteration);
+        self.dropped.write(&mut w);
+        self.spatial.write(&mut w, |cell, w| {
+            cell.cut.write(w);
+            w.u64(cell.splats.get());
+            w.u64(cell.split_count);
+        });
+        w.finish(Kind::Glt)
+    }
+
+    /// The GLT saved by [`Glt::to_bytes`] over `tree`, which must be the
+    /// hierarchy it was trained with ([`LoadError::LightTreeMismatch`]
+    /// otherwise). Everything is checked; a GLT that loads samples, gives
+    /// pmfs and learns exactly like the one saved.
+    pub fn from_bytes(bytes: &[u8], tree: H) -> Result<Self, LoadError> {
+        let mut r = Reader::open(bytes, Kind::Glt)?;
+        let saved = r.u64("light tree fingerprint")?;
+        let given = fingerprint(&tree);
+        if saved != given {
+            return Err(LoadError::LightTreeMismatch { saved, given });
+        }
+        let at = r.offset();
+        let config = GltConfig::read(&mut r)?;
+        let guide = CutRules::new(tree, config.cut).map_err(|e| config_error(e, at))?;
+        let iteration = r.u32("iteration")?;
+        let dropped = DropCounters::read(&mut r)?;
+        let spatial = crate::spatial::BinaryTree::read(&mut r, |r| {
+            Ok(GltCell {
+                cut: GuidingCut::read(r, &guide)?,
+                splats: Counter::with(r.u64("cell: splats")?),
+                split_count: r.u64("cell: split count")?,
+            })
+        })?;
+        r.end()?;
+        Ok(Self {
+            guide,
+            config,
+            spatial,
+            iteration,
+            dropped,
+        })
+    }
+
+    /// Adds what `other` accumulated since its last refinement (sums,
+    /// splat counts, drop counts) to this GLT, so that N workers that each
+    /// trained a copy of the same GLT on part of the samples refine once,
+    /// together. Both must have the same light hierarchy, configuration,
+    /// spatial tree and cuts (copies of one GLT after the same
+    /// refinements); otherwise nothing changes and this is `false`. In
+    /// [`Accumulation::Deterministic`] the merged state is bit for bit what
+    /// one GLT splatting all the workers' records would hold.
+    pub fn merge(&mut self, other: &Self) -> bool {
+        let same = fingerprint(self.light_tree()) == fingerprint(other.light_tree())
+            && self.config == other.config
+            && self.iteration == other.iteration
+            && self.spatial.same_layout(&other.spatial)
+            && self
+                .spatial
+                .data_slice()
+                .iter()
+                .zip(other.spatial.data_slice())
+                .all(|(a, b)| a.cut.nodes == b.cut.nodes && a.cut.unbounded == b.cut.unbounded);
+        if !same {
+            return false;
+        }
+        let cells = self.spatial.data_slice_mut();
+        for (a, b) in cells.iter_mut().zip(other.spatial.data_slice()) {
+            a.cut.merge(&b.cut);
+            a.splats.merge(&b.splats);
+            a.split_count += b.split_count;
+        }
+        self.dropped.merge(&other.dropped);
+        true
+    }
+}

@@ -1,0 +1,152 @@
+//! Saving and loading a [`LightTree`] (`src/persist/mod.rs` has the
+//! header; `docs/format.md` the layout).
+
+use super::LightTree;
+use super::node::{LEAF_BIT, LightNode, NO_PARENT};
+use crate::math::Aabb;
+use crate::persist::{Kind, LoadError, Reader, Writer};
+use alloc::vec;
+use alloc::vec::Vec;
+use glam::Vec3;
+
+impl LightTree {
+    /// The tree as bytes: a header, then the scene box, the nodes and each
+    /// emitter's leaf (`src/persist/mod.rs`).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer::default();
+        self.write(&mut w);
+        w.finish(Kind::LightTree)
+    }
+
+    /// The tree saved by [`LightTree::to_bytes`], checked: a tree that
+    /// loads is a tree (every node reached once from the root, links and
+    /// parents agree, each emitter on exactly one leaf, powers finite and
+    /// non-negative), so it samples exactly like the one saved.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, LoadError> {
+        let mut r = Reader::open(bytes, Kind::LightTree)?;
+        let tree = Self::read(&mut r)?;
+        r.end()?;
+        Ok(tree)
+    }
+
+    pub(crate) fn write(&self, w: &mut Writer) {
+        for v in [self.scene.min, self.scene.max] {
+            for x in v.to_array() {
+                w.f32(x);
+            }
+        }
+        w.len(self.nodes.len());
+        for n in &self.nodes {
+            for x in n.words() {
+                w.u32(x);
+            }
+        }
+        w.len(self.leaf_of.len());
+        for &l in &self.leaf_of {
+            w.u32(l);
+        }
+    }
+
+    pub(crate) fn read(r: &mut Reader<'_>) -> Result<Self, LoadError> {
+        let at = r.offset();
+        let mut corners = [Vec3::ZERO; 2];
+        for c in &mut corners {
+            for k in 0..3 {
+                c[k] = r.f32("light tree: scene box")?;
+            }
+        }
+        let scene = Aabb {
+            min: corners[0],
+            max: corners[1],
+        };
+        let count = r.len("light tree: node count", 32)?;
+        let mut nodes = Vec::with_capacity(count);
+        for _ in 0..count {
+            let mut words = [0u32; 8];
+            for x in &mut words {
+                *x = r.u32("light tree: node")?;
+            }
+            nodes.push(LightNode::from_words(words));
+        }
+        let emitters = r.len("light tree: emitter count", 4)?;
+        let leaf_at = r.offset();
+        let mut leaf_of = Vec::with_capacity(emitters);
+        for _ in 0..emitters {
+            leaf_of.push(r.u32("light tree: leaf of emitter")?);
+        }
+        let box_ok = if nodes.is_empty() {
+            scene == Aabb::EMPTY || (scene.min.is_finite() && scene.max.is_finite())
+        } else {
+            scene.min.is_finite() && scene.max.is_finite() && scene.min.cmple(scene.max).all()
+        };
+        if !box_ok {
+            return Err(Reader::invalid("light tree: scene box", at));
+        }
+        let depth = check_structure(&nodes, &leaf_of).map_err(|field| {
+            Reader::invalid(field, if field.contains("leaf") { leaf_at } else { at })
+        })?;
+        Ok(Self {
+            nodes,
+            leaf_of,
+            scene,
+            depth,
+        })
+    }
+}
+
+/// Checks that `nodes` is one depth-first tree from node 0 whose leaves
+/// hold each emitter of `leaf_of` once, with finite non-negative powers;
+/// returns its depth.
+fn check_structure(nodes: &[LightNode], leaf_of: &[u32]) -> Result<usize, &'static str> {
+    let n = nodes.len();
+    if n == 0 {
+        return if leaf_of.is_empty() {
+            Ok(0)
+        } else {
+            Err("light tree: leaf of emitter")
+        };
+    }
+    if nodes[0].parent() != NO_PARENT {
+        return Err("light tree: root parent");
+    }
+    let mut seen = vec![false; n];
+    let mut leaves = 0usize;
+    let mut depth = 0usize;
+    let mut stack = vec![(0usize, 0usize)];
+    while let Some((i, d)) = stack.pop() {
+        if core::mem::replace(&mut seen[i], true) {
+            return Err("light tree: node reached twice");
+        }
+        let node = &nodes[i];
+        let p = node.power();
+        if !(p >= 0.0 && p.is_finite()) {
+            return Err("light tree: node power");
+        }
+        depth = depth.max(d);
+        if node.is_leaf() {
+            let e = (node.link() & !LEAF_BIT) as usize;
+            if leaf_of.get(e) != Some(&(i as u32)) {
+                return Err("light tree: leaf of emitter");
+            }
+            leaves += 1;
+            continue;
+        }
+        let (l, r) = (i + 1, node.link() as usize);
+        if l >= n || r >= n || r <= l {
+            return Err("light tree: child link");
+        }
+        for c in [l, r] {
+            if nodes[c].parent() as usize != i {
+                return Err("light tree: parent link");
+            }
+            stack.push((c, d + 1));
+        }
+    }
+    if seen.iter().any(|s| !s) {
+        return Err("light tree: node not reached");
+    }
+    if leaves != leaf_of.len() {
+        return Err("light tree: leaf of emitter");
+    }
+    Ok(depth)
+}

@@ -1,0 +1,88 @@
+//! Saving and loading what was learned, and the light tree it refers to:
+//! `to_bytes` / `from_bytes` on [`LightTree`](crate::LightTree),
+//! [`SdTree`](crate::sd_tree::SdTree), [`Glt`](crate::glt::Glt) and
+//! [`GuidingField`](crate::field::GuidingField), over byte slices (no
+//! `std` needed).
+//!
+//! Every buffer starts with a header: the magic `GUIDING\0`, the format
+//! version (a `u32`, [`FORMAT_VERSION`]), the crate version that wrote it
+//! (three `u16`), the [`Kind`] of structure (`u32`), the payload's length
+//! (`u64`) and an FNV-1a 64 checksum (`u64`) of the header before it and
+//! the payload; then the payload. Every
+//! number is little-endian on every platform; `f32` and `f64` are stored
+//! as their bits. The layout of each payload is in `docs/format.md`.
+//!
+//! Loading checks everything the in-memory code relies on (indices in
+//! range, each tree a tree, cuts covering each light once, probabilities
+//! and sums finite and non-negative, configurations valid), so a buffer
+//! that loads samples and evaluates exactly like the structure that was
+//! saved, and a corrupted or hostile one is a [`LoadError`] naming the
+//! field and offset. No length in a buffer is trusted beyond the bytes
+//! that follow it. Counts of what was recorded are data, not lengths, and
+//! are taken as they are: a buffer claiming 2^60 splats in a cell makes the
+//! next `refine` split that cell as 2^60 splats would, so load buffers from
+//! untrusted sources into a structure whose refinement is bounded
+//! (`max_bytes`), or do not refine them.
+//!
+//! Learned state refers to the light hierarchy it was trained with: the
+//! file holds the hierarchy's [`fingerprint`], and loading against another
+//! hierarchy (other lights, another order, another build) is
+//! [`LoadError::LightTreeMismatch`]. Between runs a renderer may change the
+//! camera, the resolution and the sample counts; it may not change the
+//! lights or how the light tree is built (save the tree with the state, or
+//! build it the same way from the same lights).
+
+mod bytes;
+mod error;
+
+pub(crate) use bytes::{Fnv, Reader, Writer};
+pub use error::LoadError;
+
+use crate::light_tree::LightHierarchy;
+
+/// The format version this build writes (and the newest it reads). It
+/// changes whenever any payload's layout changes; a build reads every
+/// version up to its own.
+pub const FORMAT_VERSION: u32 = bytes::FORMAT_VERSION;
+
+/// Which structure a buffer holds (the header's `kind`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u32)]
+pub enum Kind {
+    /// A [`LightTree`](crate::LightTree).
+    LightTree = 1,
+    /// An [`SdTree`](crate::sd_tree::SdTree).
+    SdTree = 2,
+    /// A [`Glt`](crate::glt::Glt).
+    Glt = 3,
+    /// A [`GuidingField`](crate::field::GuidingField).
+    Field = 4,
+}
+
+/// A fingerprint of a light hierarchy: FNV-1a 64 over every node's
+/// children, emitter, power and decoded bounds, in node order. Equal
+/// hierarchies (the same lights built the same way) have equal
+/// fingerprints; learned state is only loaded against its own.
+pub fn fingerprint<H: LightHierarchy + ?Sized>(tree: &H) -> u64 {
+    let mut h = Fnv::new();
+    let n = tree.node_count();
+    h.u32(n as u32);
+    h.u32(tree.emitter_count() as u32);
+    for i in 0..n as u32 {
+        let [l, r] = tree.children(i).unwrap_or([u32::MAX; 2]);
+        h.u32(l);
+        h.u32(r);
+        h.u32(tree.emitter(i).unwrap_or(u32::MAX));
+        let b = tree.node_bounds(i);
+        h.u32(b.power.to_bits());
+        for v in [b.bounds.min, b.bounds.max, b.cone.axis] {
+            for x in v.to_array() {
+                h.u32(x.to_bits());
+            }
+        }
+        h.u32(b.cone.cos_theta_o.to_bits());
+        h.u32(b.cone.cos_theta_e.to_bits());
+        h.u32(u32::from(b.two_sided));
+    }
+    h.finish()
+}
