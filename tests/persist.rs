@@ -313,3 +313,173 @@ fn hostile_lengths_allocate_nothing() {
         })
     ));
 }
+
+mod sd_and_field {
+    use super::*;
+    use guiding::field::{FieldConfig, GuidingField};
+    use guiding::sd_tree::{SdTree, SdTreeConfig};
+
+    fn sd_config(accumulation: Accumulation) -> SdTreeConfig {
+        let mut c = SdTreeConfig::improved();
+        c.spatial_threshold = 300.0;
+        c.accumulation = accumulation;
+        c
+    }
+
+    /// Radiance records: bright around +y.
+    fn radiance(rng: &mut Rand) -> (Vec3, f32) {
+        let d = rng.dir();
+        (d, 1.0 + 50.0 * d.y.max(0.0).powi(8))
+    }
+
+    fn train_sd(sd: &SdTree, rng: &mut Rand, n: usize) {
+        for _ in 0..n {
+            let p = rng.point(9.5);
+            let v = sd.vertex(p).unwrap();
+            let (d, r) = radiance(rng);
+            v.splat_radiance(d, r, 0.3, &mut rng.0);
+            v.record_fraction(0.2, 0.4, r);
+        }
+    }
+
+    fn assert_same_sd(a: &SdTree, b: &SdTree, seed: u64) {
+        let mut rng = Rand::new(seed);
+        for _ in 0..300 {
+            let p = rng.point(11.0);
+            let (va, vb) = (a.vertex(p).unwrap(), b.vertex(p).unwrap());
+            let u = [rng.f(), rng.f()];
+            let (da, pa) = va.sample_direction(u);
+            let (db, pb) = vb.sample_direction(u);
+            assert_eq!((da, pa.to_bits()), (db, pb.to_bits()));
+            let d = rng.dir();
+            assert_eq!(va.direction_pdf(d).to_bits(), vb.direction_pdf(d).to_bits());
+            assert_eq!(va.bsdf_fraction().to_bits(), vb.bsdf_fraction().to_bits());
+        }
+    }
+
+    #[test]
+    fn sd_tree_round_trips_and_learns_on_identically() {
+        for accumulation in [Accumulation::Fast, Accumulation::Deterministic] {
+            let mut sd = SdTree::new(scene(), sd_config(accumulation)).unwrap();
+            let mut rng = Rand::new(1);
+            for _ in 0..3 {
+                train_sd(&sd, &mut rng, 5000);
+                sd.refine();
+            }
+            train_sd(&sd, &mut rng, 1000);
+            let bytes = sd.to_bytes();
+            let mut back = SdTree::from_bytes(&bytes).unwrap();
+            assert_eq!(back.to_bytes(), bytes);
+            assert_same_sd(&sd, &back, 2);
+            let (mut ra, mut rb) = (Rand::new(3), Rand::new(3));
+            train_sd(&sd, &mut ra, 3000);
+            train_sd(&back, &mut rb, 3000);
+            sd.refine();
+            back.refine();
+            if accumulation == Accumulation::Deterministic {
+                assert_eq!(back.to_bytes(), sd.to_bytes());
+            }
+            assert_same_sd(&sd, &back, 4);
+        }
+    }
+
+    #[test]
+    fn field_round_trips_and_checks_its_light_tree() {
+        let lights = two_rooms();
+        let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+        for accumulation in [Accumulation::Fast, Accumulation::Deterministic] {
+            let config = FieldConfig {
+                sd: sd_config(accumulation),
+                cut: CutConfig {
+                    accumulation,
+                    unbounded: UnboundedLights::new(1, 0.1).unwrap(),
+                    ..CutConfig::default()
+                },
+                ..FieldConfig::default()
+            };
+            let mut field = GuidingField::new(&tree, scene(), config).unwrap();
+            let mut rng = Rand::new(5);
+            for _ in 0..3 {
+                for _ in 0..4000 {
+                    let p = rng.point(9.5);
+                    let v = field.vertex(p).unwrap();
+                    let x = v.sample(&ShadingContext::at(p), rng.f()).unwrap();
+                    let val = match x.light {
+                        LightId::Emitter(e) => value(&lights, e, p) / x.pmf,
+                        LightId::Unbounded(_) => 0.5,
+                    };
+                    v.splat_light(x.light, val, &mut rng.0);
+                    let (d, r) = radiance(&mut rng);
+                    v.splat_radiance(d, r, 0.3, &mut rng.0);
+                }
+                field.refine();
+            }
+            let bytes = field.to_bytes();
+            let back = GuidingField::from_bytes(&bytes, &tree).unwrap();
+            assert_eq!(back.to_bytes(), bytes);
+            let mut rng = Rand::new(6);
+            for _ in 0..300 {
+                let p = rng.point(11.0);
+                let ctx = ShadingContext::on_surface(p, rng.dir());
+                let u = rng.f64();
+                assert_eq!(field.sample_exact(&ctx, u), back.sample_exact(&ctx, u));
+                let (a, b) = (field.vertex(p).unwrap(), back.vertex(p).unwrap());
+                let d = rng.dir();
+                assert_eq!(a.direction_pdf(d).to_bits(), b.direction_pdf(d).to_bits());
+            }
+            let mut other = lights.clone();
+            other.pop();
+            let other = LightTree::build(&other, BuildHeuristic::Sarh).unwrap();
+            assert!(matches!(
+                GuidingField::from_bytes(&bytes, &other),
+                Err(LoadError::LightTreeMismatch { .. })
+            ));
+            assert!(matches!(
+                SdTree::from_bytes(&bytes),
+                Err(LoadError::WrongKind { .. })
+            ));
+        }
+    }
+
+    /// Hostile rewrites of a small SD-tree and field: typed errors or
+    /// structures that keep their contracts, never a panic.
+    #[test]
+    fn hostile_sd_and_field_buffers_never_panic() {
+        let lights: Vec<Emitter> = two_rooms().into_iter().take(4).collect();
+        let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+        let mut config = FieldConfig::default();
+        config.sd.spatial_threshold = 30.0;
+        config.sd.learn_bsdf_fraction = true;
+        let mut field = GuidingField::new(&tree, scene(), config).unwrap();
+        let mut rng = Rand::new(9);
+        for _ in 0..2 {
+            for _ in 0..200 {
+                let p = rng.point(9.5);
+                let v = field.vertex(p).unwrap();
+                let (d, r) = radiance(&mut rng);
+                v.splat_radiance(d, r, 0.3, &mut rng.0);
+                v.splat_light(LightId::Emitter(rng.below(4)), 1.0, &mut rng.0);
+            }
+            field.refine();
+        }
+        let bytes = field.to_bytes();
+        assert!(bytes.len() < 60_000, "{}", bytes.len());
+        let mut loaded = 0;
+        for i in HEADER..bytes.len() {
+            let mut hostile = bytes.clone();
+            hostile[i] ^= 0x41;
+            if let Ok(f) = GuidingField::from_bytes(&resealed(hostile), &tree) {
+                loaded += 1;
+                let p = rng.point(9.0);
+                let ctx = ShadingContext::at(p);
+                let total: f64 = (0..4).map(|e| f.pmf_exact(&ctx, LightId::Emitter(e))).sum();
+                assert!((total - 1.0).abs() < 1e-5);
+                let v = f.vertex(p).unwrap();
+                let (d, pdf) = v.sample_direction([rng.f(), rng.f()]);
+                assert!(pdf > 0.0 && pdf.is_finite(), "{pdf}");
+                assert!((v.direction_pdf(d) - pdf).abs() <= 1e-3 * pdf);
+            }
+        }
+        assert!(loaded > 0);
+    }
+}

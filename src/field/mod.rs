@@ -98,6 +98,7 @@
 mod cell;
 mod config;
 mod memory;
+mod persist;
 mod splat;
 mod vertex;
 

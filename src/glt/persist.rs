@@ -10,41 +10,11 @@ use super::standalone::{Glt, GltCell, GltConfig};
 use crate::dropped::DropCounters;
 use crate::light_sampler::UnboundedLights;
 use crate::light_tree::LightHierarchy;
-use crate::math::{Accumulation, Counter, SumBuffer};
-use crate::persist::{Kind, LoadError, Reader, Writer, fingerprint};
-use crate::spatial::SpatialFilter;
+use crate::math::{Counter, SumBuffer};
+use crate::persist::{
+    ACCUMULATION, FILTERS, Kind, LoadError, Reader, Writer, config_error, fingerprint, tag, untag,
+};
 use alloc::vec::Vec;
-
-/// A field's `ConfigError` as a load error at `offset`.
-pub(crate) fn config_error(e: crate::ConfigError, offset: usize) -> LoadError {
-    Reader::invalid(e.field, offset)
-}
-
-/// `x` as one byte by its position in `all`.
-fn tag<T: PartialEq + Copy>(all: &[T], x: T) -> u8 {
-    all.iter().position(|&a| a == x).unwrap_or(0) as u8
-}
-
-/// The variant at position `byte` of `all`.
-pub(crate) fn untag<T: Copy>(
-    r: &mut Reader<'_>,
-    field: &'static str,
-    all: &[T],
-) -> Result<T, LoadError> {
-    let at = r.offset();
-    let b = r.u8(field)?;
-    all.get(usize::from(b))
-        .copied()
-        .ok_or_else(|| Reader::invalid(field, at))
-}
-
-pub(crate) const ACCUMULATION: [Accumulation; 2] =
-    [Accumulation::Fast, Accumulation::Deterministic];
-pub(crate) const FILTERS: [SpatialFilter; 3] = [
-    SpatialFilter::Nearest,
-    SpatialFilter::StochasticBox,
-    SpatialFilter::Box,
-];
 
 impl CutConfig {
     pub(crate) fn write(&self, w: &mut Writer) {
@@ -192,9 +162,17 @@ impl GuidingCut {
         Ok(cut)
     }
 
-    /// Adds `other`'s accumulating state (same topology) to this cut's.
+    /// Whether `other` samples the same distribution (what a merge
+    /// requires).
+    pub(crate) fn same_layout(&self, other: &Self) -> bool {
+        self.nodes == other.nodes
+            && self.unbounded == other.unbounded
+            && self.modulated == other.modulated
+    }
+
+    /// Adds `other`'s accumulating state (same layout) to this cut's.
     pub(crate) fn merge(&mut self, other: &Self) -> bool {
-        if self.nodes != other.nodes || self.unbounded != other.unbounded {
+        if !self.same_layout(other) {
             return false;
         }
         if !(self.sums.merge(&other.sums) && self.anchor.merge(&other.anchor)) {
@@ -276,7 +254,7 @@ impl<H: LightHierarchy> Glt<H> {
                 .data_slice()
                 .iter()
                 .zip(other.spatial.data_slice())
-                .all(|(a, b)| a.cut.nodes == b.cut.nodes && a.cut.unbounded == b.cut.unbounded);
+                .all(|(a, b)| a.cut.same_layout(&b.cut));
         if !same {
             return false;
         }

@@ -34,9 +34,11 @@
 
 mod bytes;
 mod error;
+mod tags;
 
 pub(crate) use bytes::{Fnv, Reader, Writer};
 pub use error::LoadError;
+pub(crate) use tags::{ACCUMULATION, FILTERS, config_error, tag, untag};
 
 use crate::light_tree::LightHierarchy;
 

@@ -42,6 +42,7 @@ mod cell;
 mod config;
 mod leaves;
 mod node;
+mod persist;
 mod query;
 mod refine;
 mod splat;

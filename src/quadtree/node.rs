@@ -28,6 +28,11 @@ impl Link {
         Self { first_child, mask }
     }
 
+    /// The stored fields (the save format): first child and mask.
+    pub(crate) fn raw(self) -> (u32, u32) {
+        (self.first_child, self.mask)
+    }
+
     /// The child node of quadrant `q`, if the quadrant is not a leaf.
     #[inline]
     pub(crate) fn child(self, q: usize) -> Option<usize> {

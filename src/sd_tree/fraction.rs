@@ -71,6 +71,37 @@ pub(crate) struct FractionLearner {
 }
 
 impl FractionLearner {
+    /// Writes the optimiser's state and the fraction.
+    pub(crate) fn write(&self, w: &mut crate::persist::Writer) {
+        for x in [self.theta, self.m, self.v, self.beta1_t, self.beta2_t] {
+            w.f64(x);
+        }
+        w.f32(self.fraction);
+    }
+
+    /// Reads what [`FractionLearner::write`] wrote: finite state, the
+    /// fraction in `[0, 1]`.
+    pub(crate) fn read(
+        r: &mut crate::persist::Reader<'_>,
+    ) -> Result<Self, crate::persist::LoadError> {
+        use crate::persist::Reader;
+        let mut x = [0.0f64; 5];
+        for v in &mut x {
+            *v = r.check("fraction learner", Reader::f64, |v| v.is_finite())?;
+        }
+        let fraction = r.check("fraction", Reader::f32, |f| (0.0..=1.0).contains(f))?;
+        Ok(Self {
+            theta: x[0],
+            m: x[1],
+            v: x[2],
+            beta1_t: x[3],
+            beta2_t: x[4],
+            fraction,
+        })
+    }
+}
+
+impl FractionLearner {
     /// Starting at `fraction` (in `[0, 1]`; the ends map to `theta = -+20`).
     pub(crate) fn new(fraction: f32) -> Self {
         let f = fraction as f64;

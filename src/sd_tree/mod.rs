@@ -108,6 +108,7 @@ mod cell;
 mod config;
 mod fraction;
 mod memory;
+mod persist;
 mod query;
 mod refine;
 mod splat;

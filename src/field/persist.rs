@@ -1,0 +1,91 @@
+//! Saving and loading the combined field, checked; merging two fields'
+//! statistics.
+
+use super::{FieldCell, GuidingField};
+use crate::glt::{CutConfig, CutRules, GuidingCut};
+use crate::light_tree::LightHierarchy;
+use crate::persist::{
+    FILTERS, Kind, LoadError, Reader, Writer, config_error, fingerprint, tag, untag,
+};
+use crate::sd_tree::{SdCell, SdState};
+use crate::spatial::BinaryTree;
+use alloc::vec::Vec;
+
+impl<H: LightHierarchy> GuidingField<H> {
+    /// The field as bytes: a header, the light hierarchy's fingerprint, the
+    /// SD-tree's configuration and state, the cuts' configuration, the
+    /// light filter and every cell (quadtrees, fraction, cut, sums).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer::default();
+        w.u64(fingerprint(self.light_tree()));
+        self.sd.write(&mut w);
+        self.guide.config().write(&mut w);
+        w.u8(tag(&FILTERS, self.light_filter));
+        self.cells.write(&mut w, |cell, w| {
+            cell.sd.write(w);
+            cell.cut.write(w);
+        });
+        w.finish(Kind::Field)
+    }
+
+    /// The field saved by [`GuidingField::to_bytes`] over `lights`, which
+    /// must be the hierarchy it was trained with
+    /// ([`LoadError::LightTreeMismatch`] otherwise); checked, and then
+    /// exactly like the one saved.
+    pub fn from_bytes(bytes: &[u8], lights: H) -> Result<Self, LoadError> {
+        let mut r = Reader::open(bytes, Kind::Field)?;
+        let saved = r.u64("light tree fingerprint")?;
+        let given = fingerprint(&lights);
+        if saved != given {
+            return Err(LoadError::LightTreeMismatch { saved, given });
+        }
+        let sd = SdState::read(&mut r)?;
+        let at = r.offset();
+        let config = CutConfig::read(&mut r)?;
+        let guide = CutRules::new(lights, config).map_err(|e| config_error(e, at))?;
+        let light_filter = untag(&mut r, "light filter", &FILTERS)?;
+        let cells = BinaryTree::read(&mut r, |r| {
+            Ok(FieldCell {
+                sd: SdCell::read(r, &sd.config)?,
+                cut: GuidingCut::read(r, &guide)?,
+            })
+        })?;
+        r.end()?;
+        Ok(Self {
+            cells,
+            sd,
+            guide,
+            light_filter,
+        })
+    }
+
+    /// Adds what `other` recorded since its last refinement to this field
+    /// (see [`Glt::merge`](crate::glt::Glt::merge)): both must be copies of
+    /// one field after the same refinements, else nothing changes and this
+    /// is `false`. Deterministic mode merges bit for bit.
+    pub fn merge(&mut self, other: &Self) -> bool {
+        let same = fingerprint(self.light_tree()) == fingerprint(other.light_tree())
+            && self.guide.config() == other.guide.config()
+            && self.light_filter == other.light_filter
+            && self.cells.same_layout(&other.cells)
+            && self
+                .cells
+                .data_slice()
+                .iter()
+                .zip(other.cells.data_slice())
+                .all(|(a, b)| a.sd.same_layout(&b.sd) && a.cut.same_layout(&b.cut));
+        if !same || !self.sd.merge(&other.sd) {
+            return false;
+        }
+        for (a, b) in self
+            .cells
+            .data_slice_mut()
+            .iter_mut()
+            .zip(other.cells.data_slice())
+        {
+            a.sd.merge(&b.sd);
+            a.cut.merge(&b.cut);
+        }
+        true
+    }
+}

@@ -1,0 +1,238 @@
+//! N workers that each record part of the samples into a copy of the same
+//! structure, exchange their state as bytes, merge and refine once, learn
+//! bit for bit what one process recording every sample learns
+//! (deterministic mode), for 1, 2 and 4 workers; merging mismatched
+//! structures is refused and changes nothing.
+
+mod common;
+
+use common::{Rand, scene, two_rooms, value};
+use glam::Vec3;
+use guiding::field::{FieldConfig, GuidingField};
+use guiding::glt::{CutConfig, Glt, GltConfig};
+use guiding::light_tree::BuildHeuristic;
+use guiding::math::Accumulation;
+use guiding::sd_tree::{SdTree, SdTreeConfig};
+use guiding::spatial::JitterNumbers;
+use guiding::{LightId, LightTree};
+
+/// One sample's records: a position, a light and its value, a direction
+/// and its radiance, and the numbers a jittered splat draws.
+#[derive(Clone, Copy)]
+struct Sample {
+    p: Vec3,
+    light: u32,
+    light_value: f32,
+    dir: Vec3,
+    radiance: f32,
+    jitter: [f32; 3],
+}
+
+fn samples(seed: u64, n: usize) -> Vec<Sample> {
+    let lights = two_rooms();
+    let mut rng = Rand::new(seed);
+    (0..n)
+        .map(|_| {
+            let p = rng.point(9.5);
+            let light = rng.below(80);
+            let dir = rng.dir();
+            Sample {
+                p,
+                light,
+                light_value: value(&lights, light, p) * rng.range(0.5, 2.0),
+                dir,
+                radiance: 1.0 + 30.0 * dir.y.max(0.0).powi(6),
+                jitter: [rng.f(), rng.f(), rng.f()],
+            }
+        })
+        .collect()
+}
+
+/// What a structure must offer for the farm test.
+trait Farmable: Sized {
+    fn record(&self, s: &Sample);
+    fn bytes(&self) -> Vec<u8>;
+    fn load(bytes: &[u8], tree: &LightTree) -> Self;
+    fn merge_in(&mut self, other: &Self) -> bool;
+    fn refine_once(&mut self);
+}
+
+impl Farmable for Glt<&'static LightTree> {
+    fn record(&self, s: &Sample) {
+        self.splat_at(s.p, LightId::Emitter(s.light), s.light_value);
+    }
+    fn bytes(&self) -> Vec<u8> {
+        self.to_bytes()
+    }
+    fn load(bytes: &[u8], _: &LightTree) -> Self {
+        Glt::from_bytes(bytes, tree()).unwrap()
+    }
+    fn merge_in(&mut self, other: &Self) -> bool {
+        self.merge(other)
+    }
+    fn refine_once(&mut self) {
+        self.refine();
+    }
+}
+
+impl Farmable for SdTree {
+    fn record(&self, s: &Sample) {
+        let v = self.vertex(s.p).unwrap();
+        v.splat_radiance(s.dir, s.radiance, 0.4, &mut JitterNumbers(s.jitter));
+        v.record_fraction(0.3, 0.5, s.radiance);
+    }
+    fn bytes(&self) -> Vec<u8> {
+        self.to_bytes()
+    }
+    fn load(bytes: &[u8], _: &LightTree) -> Self {
+        SdTree::from_bytes(bytes).unwrap()
+    }
+    fn merge_in(&mut self, other: &Self) -> bool {
+        self.merge(other)
+    }
+    fn refine_once(&mut self) {
+        self.refine();
+    }
+}
+
+impl Farmable for GuidingField<&'static LightTree> {
+    fn record(&self, s: &Sample) {
+        let v = self.vertex(s.p).unwrap();
+        v.splat_light(
+            LightId::Emitter(s.light),
+            s.light_value,
+            &mut JitterNumbers(s.jitter),
+        );
+        v.splat_radiance(s.dir, s.radiance, 0.4, &mut JitterNumbers(s.jitter));
+    }
+    fn bytes(&self) -> Vec<u8> {
+        self.to_bytes()
+    }
+    fn load(bytes: &[u8], _: &LightTree) -> Self {
+        GuidingField::from_bytes(bytes, tree()).unwrap()
+    }
+    fn merge_in(&mut self, other: &Self) -> bool {
+        self.merge(other)
+    }
+    fn refine_once(&mut self) {
+        self.refine();
+    }
+}
+
+/// The light tree every structure here uses (leaked once: `'static`).
+fn tree() -> &'static LightTree {
+    static TREE: std::sync::OnceLock<LightTree> = std::sync::OnceLock::new();
+    TREE.get_or_init(|| LightTree::build(&two_rooms(), BuildHeuristic::Sarh).unwrap())
+}
+
+/// Three iterations: every worker starts from the bytes of the last
+/// refined state, records its share (sample `i` goes to worker `i % n`),
+/// the shares are merged from bytes into one and refined. Returns the
+/// final state's bytes.
+fn farm<F: Farmable>(start: &F, workers: usize, stream: &[Vec<Sample>]) -> Vec<u8> {
+    let mut state = start.bytes();
+    for round in stream {
+        let shares: Vec<Vec<u8>> = (0..workers)
+            .map(|w| {
+                let local = F::load(&state, tree());
+                for s in round.iter().skip(w).step_by(workers) {
+                    local.record(s);
+                }
+                local.bytes()
+            })
+            .collect();
+        let mut merged = F::load(&shares[0], tree());
+        for share in &shares[1..] {
+            assert!(merged.merge_in(&F::load(share, tree())));
+        }
+        merged.refine_once();
+        state = merged.bytes();
+    }
+    state
+}
+
+fn check_farm<F: Farmable>(start: F) {
+    let stream: Vec<Vec<Sample>> = (0..3).map(|k| samples(10 + k, 6000)).collect();
+    let one = farm(&start, 1, &stream);
+    for n in [2, 4] {
+        assert!(
+            farm(&start, n, &stream) == one,
+            "{n} workers differ from one"
+        );
+    }
+    // And the state did learn (it is not the start).
+    assert_ne!(one, start.bytes());
+}
+
+#[test]
+fn glt_workers_merge_bit_for_bit() {
+    let config = GltConfig {
+        cut: CutConfig {
+            accumulation: Accumulation::Deterministic,
+            ..CutConfig::default()
+        },
+        spatial_threshold: 400.0,
+        ..GltConfig::default()
+    };
+    check_farm(Glt::new(tree(), scene(), config).unwrap());
+}
+
+#[test]
+fn sd_tree_workers_merge_bit_for_bit() {
+    let mut config = SdTreeConfig::improved();
+    config.accumulation = Accumulation::Deterministic;
+    config.spatial_threshold = 400.0;
+    check_farm(SdTree::new(scene(), config).unwrap());
+}
+
+#[test]
+fn field_workers_merge_bit_for_bit() {
+    let mut config = FieldConfig {
+        sd: SdTreeConfig::improved(),
+        ..FieldConfig::default()
+    };
+    config.sd.accumulation = Accumulation::Deterministic;
+    config.sd.spatial_threshold = 400.0;
+    config.cut.accumulation = Accumulation::Deterministic;
+    check_farm(GuidingField::new(tree(), scene(), config).unwrap());
+}
+
+/// Structures that are not copies of one (another configuration, another
+/// refinement) refuse to merge and stay as they were.
+#[test]
+fn mismatched_merges_are_refused() {
+    let config = GltConfig {
+        spatial_threshold: 400.0,
+        ..GltConfig::default()
+    };
+    let mut a = Glt::new(tree(), scene(), config).unwrap();
+    let other = Glt::new(
+        tree(),
+        scene(),
+        GltConfig {
+            spatial_threshold: 500.0,
+            ..config
+        },
+    )
+    .unwrap();
+    for s in &samples(1, 3000) {
+        a.record(s);
+    }
+    let before = a.to_bytes();
+    assert!(!a.merge(&other));
+    assert_eq!(a.to_bytes(), before);
+    let mut refined = Glt::new(tree(), scene(), config).unwrap();
+    for s in &samples(2, 3000) {
+        refined.record(s);
+    }
+    refined.refine();
+    assert!(!a.merge(&refined));
+    assert_eq!(a.to_bytes(), before);
+    let mut sd = SdTree::new(scene(), SdTreeConfig::default()).unwrap();
+    let mut sd2 = SdTree::new(scene(), SdTreeConfig::default()).unwrap();
+    for s in &samples(3, 3000) {
+        sd2.record(s);
+    }
+    sd2.refine();
+    assert!(!sd.merge(&sd2));
+}
