@@ -95,6 +95,7 @@ fn methods_agree(name: &str, width: u32, height: u32, spp: u64) {
         },
         seed: 3,
         progress: false,
+        guide_files: Default::default(),
     };
     let results: Vec<(Method, Vec<(f64, f64)>)> = Method::ALL
         .iter()
@@ -176,6 +177,7 @@ fn guided_methods_train_their_structures() {
         },
         seed: 5,
         progress: false,
+        guide_files: Default::default(),
     };
     let fresh = |m: Method| {
         let mut s = settings.clone();

@@ -250,6 +250,7 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
             params: variant.params,
             seed: args.seed,
             progress: false,
+            guide_files: Default::default(),
         };
         let (_, trained) = run::render_trained(&scene, Method::PtGlt, &settings);
         let glt = trained.glt.ok_or("pt-glt trains a GLT")?;

@@ -119,6 +119,18 @@ pub struct Args {
     /// No progress bars.
     #[arg(long)]
     pub quiet: bool,
+    /// Save every trained method's learned guide (GLT, SD-tree or field)
+    /// to `DIR/<scene>-<method>.guide` after rendering.
+    #[arg(long, value_name = "DIR")]
+    pub save_guide: Option<std::path::PathBuf>,
+    /// Start every trained method from the guide saved in
+    /// `DIR/<scene>-<method>.guide` (its schedule goes on from the saved
+    /// iteration) instead of training from scratch.
+    #[arg(long, value_name = "DIR")]
+    pub load_guide: Option<std::path::PathBuf>,
+    /// Move the camera by `x,y,z` (the next frame of a camera move).
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    pub camera_shift: Option<Vec<f32>>,
 }
 
 /// Parses `--modulation`.

@@ -134,6 +134,10 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
         params,
         seed: args.seed,
         progress: !args.quiet,
+        guide_files: run::GuideFiles {
+            load: args.load_guide.clone(),
+            save: args.save_guide.clone(),
+        },
     };
     let mut all = Vec::new();
     for name in &scene_names {
@@ -171,6 +175,16 @@ fn run_scene(
     if let Some(d) = args.max_depth {
         scene.effects.max_depth = d;
         scene.fingerprint = rng::mix64(scene.fingerprint ^ u64::from(d));
+    }
+    if let Some(s) = &args.camera_shift {
+        let [x, y, z] = s[..] else {
+            return Err("--camera-shift takes three numbers: x,y,z".into());
+        };
+        let shift = glam::Vec3::new(x, y, z);
+        scene.camera.eye += shift;
+        for x in shift.to_array() {
+            scene.fingerprint = rng::mix64(scene.fingerprint ^ u64::from(x.to_bits()));
+        }
     }
     println!(
         "scene {name}: {} primitives, {} emitters, light tree {:.1} MB; effects: {}; built in {:.1} s",

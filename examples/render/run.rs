@@ -45,6 +45,52 @@ pub struct Settings {
     pub seed: u64,
     /// Draw a progress bar.
     pub progress: bool,
+    /// Where learned guides are loaded from and saved to.
+    pub guide_files: GuideFiles,
+}
+
+/// Directories of saved guides (`<scene>-<method>.guide` in each).
+#[derive(Clone, Debug, Default)]
+pub struct GuideFiles {
+    /// Start from the guide saved here.
+    pub load: Option<std::path::PathBuf>,
+    /// Save the learned guide here.
+    pub save: Option<std::path::PathBuf>,
+}
+
+impl GuideFiles {
+    fn path(dir: &std::path::Path, scene: &Scene, method: Method) -> std::path::PathBuf {
+        dir.join(format!("{}-{}.guide", scene.name, method.name()))
+    }
+
+    /// The saved guide's bytes for `method` on `scene`, if asked for and
+    /// present.
+    fn load(&self, scene: &Scene, method: Method) -> Option<Vec<u8>> {
+        let path = Self::path(self.load.as_ref()?, scene, method);
+        match std::fs::read(&path) {
+            Ok(b) => Some(b),
+            Err(e) => {
+                eprintln!("{}: {e}; training from scratch", path.display());
+                None
+            }
+        }
+    }
+
+    /// Writes `bytes` as the guide of `method` on `scene`, if asked for,
+    /// and says how its size on disk compares with its size in memory.
+    fn save(&self, scene: &Scene, method: Method, bytes: &[u8], memory: usize) {
+        let Some(dir) = &self.save else { return };
+        let path = Self::path(dir, scene, method);
+        match std::fs::create_dir_all(dir).and_then(|()| std::fs::write(&path, bytes)) {
+            Ok(()) => println!(
+                "saved {}: {:.3} MB on disk, {:.3} MB in memory",
+                path.display(),
+                bytes.len() as f64 / 1e6,
+                memory as f64 / 1e6
+            ),
+            Err(e) => eprintln!("{}: {e}", path.display()),
+        }
+    }
 }
 
 /// A finished render.
@@ -79,7 +125,13 @@ pub struct Rendered {
 const TILE: u32 = 16;
 
 /// Renders one pass (one sample per pixel) into `out` (RGB triples).
-fn render_pass(scene: &Scene, guides: &Guides, settings: &Settings, pass: u64, out: &mut [f32]) {
+pub fn render_pass(
+    scene: &Scene,
+    guides: &Guides,
+    settings: &Settings,
+    pass: u64,
+    out: &mut [f32],
+) {
     let (w, h) = (settings.width, settings.height);
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
@@ -158,11 +210,40 @@ pub fn render_trained<'a>(
     let mut sd_tree = new_sd_tree(scene, method, &settings.params);
     let mut field = new_field(scene, method, &settings.params);
     let trained = method.is_trained();
+    // A saved guide replaces the fresh one; the schedule goes on from the
+    // iteration it reached.
+    let mut k = 0u32;
+    if let Some(bytes) = settings.guide_files.load(scene, method) {
+        let tree = &scene.light_tree;
+        let loaded = if glt.is_some() {
+            Glt::from_bytes(&bytes, tree).map(|g| {
+                k = g.iteration();
+                glt = Some(g);
+            })
+        } else if sd_tree.is_some() {
+            SdTree::from_bytes(&bytes).map(|t| {
+                k = t.iteration();
+                sd_tree = Some(t);
+            })
+        } else {
+            GuidingField::from_bytes(&bytes, tree).map(|f| {
+                k = f.iteration();
+                field = Some(f);
+            })
+        };
+        if let Err(e) = loaded {
+            eprintln!(
+                "{} on {}: saved guide not loaded ({e}); training from scratch",
+                method.name(),
+                scene.name
+            );
+        }
+    }
     let bar = progress_bar(settings, method);
     let mut combiner = InverseVarianceCombiner::new();
     let mut history: VecDeque<Done> = VecDeque::new();
     let mut pass_buf = vec![0.0f32; len];
-    let (mut k, mut spp, mut sec_per_pass) = (0u32, 0u64, 0.0f64);
+    let (mut spp, mut sec_per_pass) = (0u64, 0.0f64);
     loop {
         let elapsed = start.elapsed().as_secs_f64();
         let it = match (trained, settings.budget) {
@@ -296,6 +377,16 @@ pub fn render_trained<'a>(
         glt_bytes: glt.as_ref().map_or(0, |g| g.memory().total())
             + field.as_ref().map_or(0, |f| f.memory().cut_bytes()),
     };
+    let files = &settings.guide_files;
+    if let Some(g) = &glt {
+        files.save(scene, method, &g.to_bytes(), g.memory().total());
+    }
+    if let Some(t) = &sd_tree {
+        files.save(scene, method, &t.to_bytes(), t.memory().total());
+    }
+    if let Some(f) = &field {
+        files.save(scene, method, &f.to_bytes(), f.memory().total());
+    }
     let learned = Trained {
         glt,
         sd_tree,

@@ -59,10 +59,23 @@ impl<H: LightHierarchy> GuidingField<H> {
         })
     }
 
-    /// Adds what `other` recorded since its last refinement to this field
-    /// (see [`Glt::merge`](crate::glt::Glt::merge)): both must be copies of
-    /// one field after the same refinements, else nothing changes and this
-    /// is `false`. Deterministic mode merges bit for bit.
+    /// Zeroes everything recorded since the last refinement, keeping what
+    /// was learned: the starting point of a worker's share (see
+    /// [`GuidingField::merge`]).
+    pub fn clear_records(&mut self) {
+        for cell in self.cells.data_slice_mut() {
+            cell.sd.clear_records();
+            cell.cut.clear_records();
+        }
+        self.sd.dropped.reset();
+    }
+
+    /// Adds what `other` recorded to this field, with the protocol of
+    /// [`Glt::merge`](crate::glt::Glt::merge) (workers start from the
+    /// coordinator's state after [`GuidingField::clear_records`]): both
+    /// must be copies of one field after the same refinements, else
+    /// nothing changes and this is `false`. Deterministic mode merges bit
+    /// for bit.
     pub fn merge(&mut self, other: &Self) -> bool {
         let same = fingerprint(self.light_tree()) == fingerprint(other.light_tree())
             && self.guide.config() == other.guide.config()

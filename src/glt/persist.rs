@@ -170,6 +170,14 @@ impl GuidingCut {
             && self.modulated == other.modulated
     }
 
+    /// Zeroes what was recorded since the last refinement (sums, anchor,
+    /// count), keeping the distribution.
+    pub(crate) fn clear_records(&mut self) {
+        self.sums.clear();
+        self.anchor.clear();
+        self.recorded.reset();
+    }
+
     /// Adds `other`'s accumulating state (same layout) to this cut's.
     pub(crate) fn merge(&mut self, other: &Self) -> bool {
         if !self.same_layout(other) {
@@ -236,14 +244,32 @@ impl<H: LightHierarchy> Glt<H> {
         })
     }
 
-    /// Adds what `other` accumulated since its last refinement (sums,
-    /// splat counts, drop counts) to this GLT, so that N workers that each
-    /// trained a copy of the same GLT on part of the samples refine once,
-    /// together. Both must have the same light hierarchy, configuration,
-    /// spatial tree and cuts (copies of one GLT after the same
-    /// refinements); otherwise nothing changes and this is `false`. In
-    /// [`Accumulation::Deterministic`] the merged state is bit for bit what
-    /// one GLT splatting all the workers' records would hold.
+    /// Zeroes everything recorded since the last refinement (sums, splat
+    /// and drop counts), keeping what was learned: the starting point of a
+    /// worker's share (see [`Glt::merge`]).
+    pub fn clear_records(&mut self) {
+        for cell in self.spatial.data_slice_mut() {
+            cell.cut.clear_records();
+            cell.splats.reset();
+            cell.split_count = 0;
+        }
+        self.dropped.reset();
+    }
+
+    /// Adds what `other` recorded to this GLT, so that N workers that each
+    /// record part of the samples refine once, together. The protocol: the
+    /// coordinator sends its state; each worker loads it, calls
+    /// [`Glt::clear_records`] (so its share holds only its own records,
+    /// not the coordinator's, which may carry sums a cut below
+    /// [`CutConfig::min_splats`](super::CutConfig::min_splats) keeps from
+    /// earlier iterations), records, and sends the share back; the
+    /// coordinator merges every share into its state and refines. Both
+    /// must have the same light hierarchy, configuration, spatial tree and
+    /// cuts (copies of one GLT after the same refinements); otherwise
+    /// nothing changes and this is `false`. In
+    /// [`Accumulation::Deterministic`](crate::math::Accumulation::Deterministic)
+    /// the merged state is bit for bit what one GLT recording all the
+    /// workers' records would hold (`tests/merge.rs`, `examples/farm.rs`).
     pub fn merge(&mut self, other: &Self) -> bool {
         let same = fingerprint(self.light_tree()) == fingerprint(other.light_tree())
             && self.config == other.config

@@ -124,6 +124,11 @@ impl DirectionalTree {
         })
     }
 
+    /// Zeroes the building sums (what was recorded since the last refine).
+    pub(crate) fn clear_records(&mut self) {
+        self.sums.clear();
+    }
+
     /// Adds `other`'s building sums (same building topology) to this
     /// tree's; false, nothing changed, when the topologies differ.
     pub(crate) fn merge(&mut self, other: &Self) -> bool {

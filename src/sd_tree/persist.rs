@@ -118,6 +118,13 @@ impl SdCell {
         self.directions.same_layout(&other.directions) && self.learner == other.learner
     }
 
+    /// Zeroes the cell's records (building sums, statistics).
+    pub(crate) fn clear_records(&mut self) {
+        self.directions.clear_records();
+        self.stats.clear();
+        self.split_weight = 0.0;
+    }
+
     /// Adds `other`'s statistics (same layout).
     pub(crate) fn merge(&mut self, other: &Self) {
         self.directions.merge(&other.directions);
@@ -147,8 +154,19 @@ impl SdTree {
         Ok(Self { tree, state })
     }
 
-    /// Adds what `other` recorded since its last refinement to this
-    /// SD-tree (see [`Glt::merge`](crate::glt::Glt::merge)): both must be
+    /// Zeroes everything recorded since the last refinement (building
+    /// sums, statistics, drop counts), keeping what was learned: the
+    /// starting point of a worker's share (see [`SdTree::merge`]).
+    pub fn clear_records(&mut self) {
+        for cell in self.tree.data_slice_mut() {
+            cell.clear_records();
+        }
+        self.state.dropped.reset();
+    }
+
+    /// Adds what `other` recorded to this SD-tree, with the protocol of
+    /// [`Glt::merge`](crate::glt::Glt::merge) (workers start from the
+    /// coordinator's state after [`SdTree::clear_records`]): both must be
     /// copies of one SD-tree after the same refinements, else nothing
     /// changes and this is `false`.
     pub fn merge(&mut self, other: &Self) -> bool {

@@ -1,0 +1,265 @@
+//! What each fuzz target checks, shared with the corpus regression test
+//! (`tests/fuzz_corpus.rs`): loading arbitrary bytes, building a light
+//! tree from arbitrary emitters, arbitrary splat / refine / sample
+//! sequences. Each either gets a typed error or keeps every contract;
+//! none may panic.
+
+#![allow(dead_code)]
+
+pub mod load {
+
+    use guiding::field::GuidingField;
+    use guiding::glam::Vec3;
+    use guiding::glt::Glt;
+    use guiding::sd_tree::SdTree;
+    use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
+
+    /// The light tree the learned structures are loaded against (a corpus
+    /// built from it gets past the fingerprint check).
+    pub fn tree() -> &'static LightTree {
+        static TREE: std::sync::OnceLock<LightTree> = std::sync::OnceLock::new();
+        TREE.get_or_init(|| {
+            let lights: Vec<Emitter> = (0..8)
+                .map(|i| {
+                    Emitter::point(
+                        Vec3::new(i as f32 - 4.0, 1.0, 0.5 * i as f32),
+                        1.0 + i as f32,
+                    )
+                })
+                .collect();
+            LightTree::build(&lights, Default::default()).unwrap()
+        })
+    }
+
+    fn check(s: &impl LightSampler, n: u32) {
+        let ctx = ShadingContext::at(Vec3::new(0.3, -0.2, 0.1));
+        let total: f64 = (0..n)
+            .map(|e| s.pmf_exact(&ctx, LightId::Emitter(e)))
+            .sum::<f64>()
+            + (0..4)
+                .map(|i| s.pmf_exact(&ctx, LightId::Unbounded(i)))
+                .sum::<f64>();
+        assert!(total == 0.0 || (total - 1.0).abs() < 1e-5, "{total}");
+        if let Some(x) = s.sample(&ctx, 0.37) {
+            assert_eq!(x.pmf, s.pmf(&ctx, x.light));
+        }
+    }
+
+    /// Valid saved structures over [`tree`] (the seeds of the `load`
+    /// corpus): a light tree, and a trained GLT, SD-tree and field.
+    pub fn seeds() -> Vec<Vec<u8>> {
+        use guiding::field::FieldConfig;
+        use guiding::glt::GltConfig;
+        use guiding::math::Aabb;
+        use guiding::sd_tree::SdTreeConfig;
+        let scene = Aabb::new(Vec3::splat(-6.0), Vec3::splat(6.0));
+        let glt_config = GltConfig {
+            spatial_threshold: 20.0,
+            ..GltConfig::default()
+        };
+        let mut glt = Glt::new(tree(), scene, glt_config).unwrap();
+        let mut sd_config = SdTreeConfig::improved();
+        sd_config.spatial_threshold = 20.0;
+        let mut sd = SdTree::new(scene, sd_config).unwrap();
+        let mut field = GuidingField::new(
+            tree(),
+            scene,
+            FieldConfig {
+                sd: sd_config,
+                ..FieldConfig::default()
+            },
+        )
+        .unwrap();
+        for round in 0..2 {
+            for i in 0..200u32 {
+                let t = i as f32 * 0.37 + round as f32;
+                let p = Vec3::new(5.0 * t.sin(), 4.0 * (1.3 * t).cos(), 3.0 * (0.7 * t).sin());
+                let d = Vec3::new(t.cos(), 0.5, t.sin()).normalize();
+                let light = LightId::Emitter(i % 8);
+                glt.splat_at(p, light, 1.0 + (i % 5) as f32);
+                let mut j = guiding::spatial::JitterNumbers([0.5, 0.25, 0.75]);
+                sd.vertex(p)
+                    .unwrap()
+                    .splat_radiance(d, 1.0 + t.fract(), 0.5, &mut j);
+                let v = field.vertex(p).unwrap();
+                v.splat_light(light, 2.0, &mut j);
+                v.splat_radiance(d, 1.0, 0.5, &mut j);
+            }
+            glt.refine();
+            sd.refine();
+            field.refine();
+        }
+        vec![
+            tree().to_bytes(),
+            glt.to_bytes(),
+            sd.to_bytes(),
+            field.to_bytes(),
+        ]
+    }
+
+    pub fn load(data: &[u8]) {
+        if let Ok(t) = LightTree::from_bytes(data) {
+            check(
+                &guiding::ImportanceTreeSampler::new(&t),
+                t.nodes().len() as u32,
+            );
+        }
+        if let Ok(g) = Glt::from_bytes(data, tree()) {
+            check(&g, 8);
+        }
+        if let Ok(f) = GuidingField::from_bytes(data, tree()) {
+            check(&f, 8);
+            let v = f.vertex(Vec3::ZERO).unwrap();
+            let (_, pdf) = v.sample_direction([0.3, 0.6]);
+            assert!(pdf > 0.0 && pdf.is_finite());
+        }
+        if let Ok(t) = SdTree::from_bytes(data) {
+            let v = t.vertex(Vec3::ZERO).unwrap();
+            let (d, pdf) = v.sample_direction([0.3, 0.6]);
+            assert!(pdf > 0.0 && pdf.is_finite() && d.is_finite());
+        }
+    }
+}
+
+pub mod build {
+
+    use guiding::glam::Vec3;
+    use guiding::light_tree::BuildHeuristic;
+    use guiding::math::{Aabb, LightCone};
+    use guiding::{
+        Emitter, ImportanceTreeSampler, LightId, LightSampler, LightTree, ShadingContext,
+    };
+
+    fn f(b: &[u8]) -> f32 {
+        f32::from_le_bytes([b[0], b[1], b[2], b[3]])
+    }
+
+    pub fn build_light_tree(data: &[u8]) {
+        // 40 bytes per emitter: bounds (6 f32), power, area, cone axis x and a
+        // flag byte... read loosely.
+        let emitters: Vec<Emitter> = data
+            .chunks_exact(40)
+            .take(64)
+            .map(|c| {
+                let v = |i: usize| f(&c[4 * i..4 * i + 4]);
+                Emitter {
+                    bounds: Aabb {
+                        min: Vec3::new(v(0), v(1), v(2)),
+                        max: Vec3::new(v(3), v(4), v(5)),
+                    },
+                    power: v(6),
+                    area: v(7),
+                    cone: (c[36] & 1 == 1).then(|| LightCone {
+                        axis: Vec3::new(v(8), 1.0, 0.0),
+                        cos_theta_o: f32::from(c[37]) / 255.0,
+                        cos_theta_e: f32::from(c[38]) / 255.0,
+                    }),
+                    two_sided: c[36] & 2 == 2,
+                    delta: c[36] & 4 == 4,
+                }
+            })
+            .collect();
+        for h in [BuildHeuristic::Sarh, BuildHeuristic::Balanced] {
+            if let Ok(tree) = LightTree::build(&emitters, h) {
+                let back = LightTree::from_bytes(&tree.to_bytes()).expect("a built tree reloads");
+                assert_eq!(back.nodes(), tree.nodes());
+                let s = ImportanceTreeSampler::new(&tree);
+                let ctx = ShadingContext::at(Vec3::new(0.5, 0.25, -1.0));
+                let total: f64 = (0..emitters.len() as u32)
+                    .map(|e| s.pmf_exact(&ctx, LightId::Emitter(e)))
+                    .sum();
+                assert!(total == 0.0 || (total - 1.0).abs() < 1e-4, "{total}");
+                if let Some(x) = s.sample(&ctx, 0.61) {
+                    assert_eq!(x.pmf, s.pmf(&ctx, x.light));
+                }
+            }
+        }
+    }
+}
+
+pub mod operations {
+
+    use guiding::field::{FieldConfig, GuidingField};
+    use guiding::glam::Vec3;
+    use guiding::glt::{Glt, GltConfig};
+    use guiding::math::Aabb;
+    use guiding::spatial::JitterNumbers;
+    use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
+
+    fn tree() -> &'static LightTree {
+        static TREE: std::sync::OnceLock<LightTree> = std::sync::OnceLock::new();
+        TREE.get_or_init(|| {
+            let lights: Vec<Emitter> = (0..12)
+                .map(|i| {
+                    Emitter::point(
+                        Vec3::new(i as f32 - 6.0, (i % 3) as f32, 0.0),
+                        1.0 + (i % 4) as f32,
+                    )
+                })
+                .collect();
+            LightTree::build(&lights, Default::default()).unwrap()
+        })
+    }
+
+    fn f(b: &[u8]) -> f32 {
+        f32::from_le_bytes([b[0], b[1], b[2], b[3]])
+    }
+
+    fn check(s: &impl LightSampler, p: Vec3, u: f32) {
+        let ctx = ShadingContext::at(p);
+        let total: f64 = (0..12)
+            .map(|e| s.pmf_exact(&ctx, LightId::Emitter(e)))
+            .sum();
+        assert!(total == 0.0 || (total - 1.0).abs() < 1e-5, "{total}");
+        if let Some(x) = s.sample(&ctx, u) {
+            assert!(x.pmf > 0.0 && x.pmf.is_finite());
+            assert_eq!(x.pmf, s.pmf(&ctx, x.light));
+        }
+    }
+
+    pub fn operations(data: &[u8]) {
+        let scene = Aabb::new(Vec3::splat(-8.0), Vec3::splat(8.0));
+        let small = GltConfig {
+            spatial_threshold: 8.0,
+            ..GltConfig::default()
+        };
+        let mut glt = Glt::new(tree(), scene, small).unwrap();
+        let mut config = FieldConfig::default();
+        config.sd.spatial_threshold = 8.0;
+        let mut field = GuidingField::new(tree(), scene, config).unwrap();
+        // 20 bytes per operation: kind, light, position (3 f32), value.
+        for op in data.chunks_exact(22).take(400) {
+            let p = Vec3::new(f(&op[2..6]), f(&op[6..10]), f(&op[10..14]));
+            let v = f(&op[14..18]);
+            let u = f(&op[18..22]);
+            let light = LightId::Emitter(u32::from(op[1] % 14));
+            match op[0] % 5 {
+                0 => {
+                    glt.splat_at(p, light, v);
+                }
+                1 => {
+                    glt.splat(p, light, v, &mut JitterNumbers([u, v, u]));
+                    if let Some(vx) = field.vertex(p) {
+                        vx.splat_light(light, v, &mut JitterNumbers([u, u, v]));
+                        vx.splat_radiance(
+                            Vec3::new(u, v, 1.0),
+                            v,
+                            u,
+                            &mut JitterNumbers([v, u, u]),
+                        );
+                    }
+                }
+                2 => {
+                    glt.refine();
+                    field.refine();
+                }
+                _ => {
+                    check(&glt, p, u);
+                    check(&field, p, u);
+                }
+            }
+        }
+        check(&glt, Vec3::ZERO, 0.5);
+        check(&field, Vec3::ZERO, 0.5);
+    }
+}
