@@ -19,7 +19,8 @@
 //!    (the MIS heuristics, and what a direct-light sample contributes and
 //!    records under pbrt-v4's or pbrt-v3's convention); with `std`,
 //!    [`shared_guide`] (a guide the render threads share and any of them
-//!    refines, through `&self`).
+//!    refines, through `&self`);
+//! 10. [`persist`]: saving, loading and merging what was learned.
 //!
 //! Each of [`sd_tree::SdTree`], [`glt::Glt`] and [`field::GuidingField`]
 //! locates a path vertex once with `vertex(p)` and answers and records
@@ -35,6 +36,7 @@
 //! | cut refinement (split / merge by sigma, `min_splats`) | `src/glt/refine.rs` |
 //! | the tables every cut reads (`CutRules`) | `src/glt/cut_rules.rs` |
 //! | a path's radiance records | `src/path_recorder.rs` |
+//! | the save format and its checks | `src/persist/`, `docs/format.md` |
 //! | light-tree build heuristics | `src/light_tree/build.rs` |
 //! | the importance of a light cluster | `src/light_sampler/importance.rs` |
 //! | the same, from decoded nodes in `f32` (the GLT's importance rules) | `src/light_sampler/importance_table.rs` |

@@ -2,7 +2,8 @@
 //! `to_bytes` / `from_bytes` on [`LightTree`](crate::LightTree),
 //! [`SdTree`](crate::sd_tree::SdTree), [`Glt`](crate::glt::Glt) and
 //! [`GuidingField`](crate::field::GuidingField), over byte slices (no
-//! `std` needed).
+//! `std` needed); with `std`, `read_from` and `write_to` move them through
+//! `std::io` streams without trusting a length in the stream.
 //!
 //! Every buffer starts with a header: the magic `GUIDING\0`, the format
 //! version (a `u32`, [`FORMAT_VERSION`]), the crate version that wrote it
@@ -34,10 +35,14 @@
 
 mod bytes;
 mod error;
+#[cfg(feature = "std")]
+mod io;
 mod tags;
 
 pub(crate) use bytes::{Fnv, Reader, Writer};
 pub use error::LoadError;
+#[cfg(feature = "std")]
+pub use io::{read_from, write_to};
 pub(crate) use tags::{ACCUMULATION, FILTERS, config_error, tag, untag};
 
 use crate::light_tree::LightHierarchy;

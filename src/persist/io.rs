@@ -1,0 +1,89 @@
+//! `std::io` adapters: one saved structure read from a stream without
+//! trusting its length, and written to one.
+
+use super::bytes::{HEADER_BYTES, MAGIC};
+use std::io::{self, Read, Write};
+use std::vec::Vec;
+
+/// Reads one saved structure (header and payload) from `reader`: exactly
+/// its bytes, so several can follow each other in one stream. A payload
+/// longer than `max_bytes` is refused before anything is allocated for it
+/// (`InvalidData`), as is a stream that does not start with the magic.
+/// Load the result with the structure's `from_bytes`, which checks the
+/// rest.
+pub fn read_from<R: Read + ?Sized>(reader: &mut R, max_bytes: usize) -> io::Result<Vec<u8>> {
+    let mut header = [0u8; HEADER_BYTES];
+    reader.read_exact(&mut header)?;
+    if header[..8] != MAGIC {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            "not guiding data",
+        ));
+    }
+    let mut len = [0u8; 8];
+    len.copy_from_slice(&header[HEADER_BYTES - 16..HEADER_BYTES - 8]);
+    let len = u64::from_le_bytes(len);
+    if len > max_bytes as u64 {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            "saved structure larger than allowed",
+        ));
+    }
+    let mut out = Vec::with_capacity(HEADER_BYTES + len as usize);
+    out.extend_from_slice(&header);
+    reader.take(len).read_to_end(&mut out)?;
+    if out.len() != HEADER_BYTES + len as usize {
+        return Err(io::ErrorKind::UnexpectedEof.into());
+    }
+    Ok(out)
+}
+
+/// Writes saved bytes (from any `to_bytes`) to `writer`.
+pub fn write_to<W: Write + ?Sized>(writer: &mut W, bytes: &[u8]) -> io::Result<()> {
+    writer.write_all(bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::LightTree;
+    use crate::emitter::Emitter;
+    use glam::Vec3;
+
+    #[test]
+    fn streams_hold_several_structures() {
+        let a =
+            LightTree::build(&[Emitter::point(Vec3::ONE, 1.0)][..], Default::default()).unwrap();
+        let b = LightTree::build(
+            &[Emitter::point(Vec3::X, 2.0), Emitter::point(Vec3::Y, 1.0)][..],
+            Default::default(),
+        )
+        .unwrap();
+        let mut stream = Vec::new();
+        write_to(&mut stream, &a.to_bytes()).unwrap();
+        write_to(&mut stream, &b.to_bytes()).unwrap();
+        let mut r = &stream[..];
+        let first = read_from(&mut r, 1 << 20).unwrap();
+        let second = read_from(&mut r, 1 << 20).unwrap();
+        assert_eq!(LightTree::from_bytes(&first).unwrap().nodes(), a.nodes());
+        assert_eq!(LightTree::from_bytes(&second).unwrap().nodes(), b.nodes());
+        assert!(r.is_empty());
+        // A length over the limit is refused before reading the payload.
+        assert_eq!(
+            read_from(&mut &stream[..], 8).unwrap_err().kind(),
+            io::ErrorKind::InvalidData
+        );
+        // Truncated.
+        let cut = &stream[..HEADER_BYTES + 3];
+        assert_eq!(
+            read_from(&mut &cut[..], 1 << 20).unwrap_err().kind(),
+            io::ErrorKind::UnexpectedEof
+        );
+        assert_eq!(
+            read_from(&mut &b"nonsense, clearly not guiding data....."[..], 100)
+                .unwrap_err()
+                .kind(),
+            io::ErrorKind::InvalidData
+        );
+    }
+}
