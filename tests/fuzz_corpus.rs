@@ -1,6 +1,8 @@
 //! The fuzz targets' checks (`fuzz/checks.rs`) on their seeds and on every
-//! input kept in `fuzz/corpus/<target>/` and `fuzz/artifacts/<target>/`
-//! (what fuzzing found stays a regression test), without libFuzzer.
+//! input in `fuzz/corpus/<target>/` (the committed `load` seeds; a fuzzing
+//! run adds what it explores) and `fuzz/artifacts/<target>/` (inputs that
+//! crashed a target: committed, they stay regression tests), without
+//! libFuzzer.
 
 #[path = "../fuzz/checks.rs"]
 mod checks;
