@@ -98,31 +98,31 @@ pub mod load {
     }
 
     /// `data` with the header's checksum recomputed (FNV-1a 64 over the 30
-/// header bytes before it and the payload), so that the structural checks,
-/// not the checksum, must catch what the fuzzer changed.
-fn resealed(data: &[u8]) -> Option<Vec<u8>> {
-    const HEADER: usize = 38;
-    if data.len() < HEADER {
-        return None;
+    /// header bytes before it and the payload), so that the structural checks,
+    /// not the checksum, must catch what the fuzzer changed.
+    fn resealed(data: &[u8]) -> Option<Vec<u8>> {
+        const HEADER: usize = 38;
+        if data.len() < HEADER {
+            return None;
+        }
+        let mut h = 0xcbf2_9ce4_8422_2325u64;
+        for &b in data[..HEADER - 8].iter().chain(&data[HEADER..]) {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+        let mut out = data.to_vec();
+        out[HEADER - 8..HEADER].copy_from_slice(&h.to_le_bytes());
+        Some(out)
     }
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
-    for &b in data[..HEADER - 8].iter().chain(&data[HEADER..]) {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0100_0000_01b3);
-    }
-    let mut out = data.to_vec();
-    out[HEADER - 8..HEADER].copy_from_slice(&h.to_le_bytes());
-    Some(out)
-}
 
-pub fn load(data: &[u8]) {
-    load_checked(data);
-    if let Some(hostile) = resealed(data) {
-        load_checked(&hostile);
+    pub fn load(data: &[u8]) {
+        load_checked(data);
+        if let Some(hostile) = resealed(data) {
+            load_checked(&hostile);
+        }
     }
-}
 
-fn load_checked(data: &[u8]) {
+    fn load_checked(data: &[u8]) {
         if let Ok(t) = LightTree::from_bytes(data) {
             check(
                 &guiding::ImportanceTreeSampler::new(&t),

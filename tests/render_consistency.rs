@@ -15,6 +15,8 @@ mod bvh;
 mod camera;
 #[path = "../examples/embed.rs"]
 mod embed;
+#[path = "../examples/render/film.rs"]
+mod film;
 #[path = "../examples/render/geometry.rs"]
 mod geometry;
 #[path = "../examples/render/integrator.rs"]
@@ -25,6 +27,10 @@ mod lights;
 mod materials;
 #[path = "../examples/render/methods.rs"]
 mod methods;
+#[path = "../examples/render/metrics.rs"]
+mod metrics;
+#[path = "../examples/render/reference.rs"]
+mod reference;
 #[path = "../examples/render/rng.rs"]
 mod rng;
 #[path = "../examples/render/run.rs"]
@@ -211,4 +217,63 @@ fn guided_methods_train_their_structures() {
             );
         }
     }
+}
+
+/// The convergence curve is recorded right: for an unbiased, unguided
+/// method on `box`, the relMSE of what the render would deliver falls as
+/// `1 / spp` (slope -1 +- 0.2 on log-log over more than a decade of
+/// samples; samples stand in for time, which they are proportional to for
+/// an unguided method, so the test does not depend on the machine's
+/// speed). The reference is a 2048-spp render of the same method.
+#[test]
+fn convergence_curve_falls_as_one_over_samples() {
+    let scene = scenes::build("box", scenes::Size::Small).expect("known scene");
+    let settings = |spp, seed| Settings {
+        width: 48,
+        height: 36,
+        budget: Budget::Spp(spp),
+        params: GuideParams::default(),
+        seed,
+        progress: false,
+        guide_files: Default::default(),
+    };
+    let r = run::render(&scene, Method::PtUniform, &settings(2048, 99));
+    let reference = reference::Reference {
+        mean: r.mean,
+        image: r.image,
+        variance: r.variance,
+        provenance: "pt-uniform 2048 spp".into(),
+        cached: false,
+    };
+    let mut curve: Vec<(u64, f64)> = Vec::new();
+    let mut observe = |c: run::CurveSample<'_>| {
+        let image: Vec<glam::Vec3> = c
+            .image
+            .chunks_exact(3)
+            .map(glam::Vec3::from_slice)
+            .collect();
+        curve.push((c.spp, metrics::errors(&image, &reference).relmse));
+    };
+    run::render_observed(
+        &scene,
+        Method::PtUniform,
+        &settings(256, 5),
+        Some(&mut observe),
+    );
+    assert!(curve.windows(2).all(|w| w[0].0 < w[1].0));
+    assert_eq!(curve.last().map(|c| c.0), Some(256));
+    let pts: Vec<(f64, f64)> = curve
+        .iter()
+        .filter(|&&(spp, _)| spp >= 16)
+        .map(|&(spp, e)| ((spp as f64).ln(), e.ln()))
+        .collect();
+    assert!(pts.len() >= 8, "{curve:?}");
+    let n = pts.len() as f64;
+    let (mx, my) = (
+        pts.iter().map(|p| p.0).sum::<f64>() / n,
+        pts.iter().map(|p| p.1).sum::<f64>() / n,
+    );
+    let slope = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
+        / pts.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
+    assert!((slope + 1.0).abs() <= 0.2, "slope {slope}: {curve:?}");
 }

@@ -128,6 +128,12 @@ pub struct Args {
     /// iteration) instead of training from scratch.
     #[arg(long, value_name = "DIR")]
     pub load_guide: Option<std::path::PathBuf>,
+    /// Do not record the convergence curves (relMSE, samples and memory
+    /// at log-spaced sample counts, into the JSON and
+    /// `<out>/<scene>/convergence.svg`); recording them is not counted
+    /// as rendering time.
+    #[arg(long)]
+    pub no_curve: bool,
     /// Move the camera by `x,y,z` (the next frame of a camera move).
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub camera_shift: Option<Vec<f32>>,

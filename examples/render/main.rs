@@ -25,6 +25,7 @@ mod lights;
 mod materials;
 mod methods;
 mod metrics;
+mod plot;
 mod reference;
 mod report;
 mod rng;
@@ -214,7 +215,26 @@ fn run_scene(
     let mut records = Vec::new();
     let mut rendered = Vec::new();
     for &method in methods {
-        let r = run::render(&scene, method, settings);
+        let mut curve = Vec::new();
+        let mut observe = |c: run::CurveSample<'_>| {
+            let image: Vec<glam::Vec3> = c
+                .image
+                .chunks_exact(3)
+                .map(glam::Vec3::from_slice)
+                .collect();
+            curve.push(report::CurvePoint {
+                seconds: c.seconds,
+                spp: c.spp,
+                relmse: metrics::errors(&image, &reference).relmse,
+                bytes: c.bytes,
+            });
+        };
+        let observer: Option<&mut dyn FnMut(run::CurveSample<'_>)> = if args.no_curve {
+            None
+        } else {
+            Some(&mut observe)
+        };
+        let r = run::render_observed(&scene, method, settings, observer).0;
         let e = metrics::errors(&r.image, &reference);
         write_outputs(&dir, method.name(), &r, exposure)?;
         records.push(Record {
@@ -238,6 +258,7 @@ fn run_scene(
             glt_bytes: r.glt_bytes,
             emitters: scene.lights.len(),
             iterations: r.iterations,
+            curve,
         });
         rendered.push((method, r, e));
     }
@@ -277,6 +298,14 @@ fn run_scene(
         dir.display(),
         sheet_path.display()
     );
+    if !args.no_curve {
+        let plot_path = dir.join("convergence.svg");
+        plot::convergence(&plot_path, name, &records)?;
+        println!(
+            "{name}: convergence plot (relMSE over time) {}",
+            plot_path.display()
+        );
+    }
     Ok(records)
 }
 

@@ -45,6 +45,22 @@ pub struct Record {
     pub emitters: usize,
     /// Training iterations.
     pub iterations: u32,
+    /// The convergence curve (empty with `--no-curve`): what the render
+    /// would have delivered at each recorded point.
+    pub curve: Vec<CurvePoint>,
+}
+
+/// One point of a convergence curve.
+#[derive(Clone, Copy, Debug)]
+pub struct CurvePoint {
+    /// Seconds of rendering so far.
+    pub seconds: f64,
+    /// Samples per pixel so far.
+    pub spp: u64,
+    /// Relative MSE of the image delivered then (reference noise removed).
+    pub relmse: f64,
+    /// Bytes of the learned structures then.
+    pub bytes: usize,
 }
 
 /// A JSON number (`null` for non-finite values).
@@ -99,6 +115,23 @@ pub fn to_json(records: &[Record]) -> String {
             ("glt_bytes", r.glt_bytes.to_string()),
             ("emitters", r.emitters.to_string()),
             ("iterations", r.iterations.to_string()),
+            (
+                "curve",
+                format!(
+                    "[{}]",
+                    r.curve
+                        .iter()
+                        .map(|p| format!(
+                            "{{\"seconds\": {}, \"spp\": {}, \"relmse\": {}, \"bytes\": {}}}",
+                            num(p.seconds),
+                            p.spp,
+                            num(p.relmse),
+                            p.bytes
+                        ))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            ),
         ];
         let body: Vec<String> = fields
             .iter()
@@ -159,5 +192,10 @@ pub fn table(records: &[Record]) -> String {
             r.glt_bytes as f64 / 1e6
         );
     }
+    let floor = records.first().map_or(f64::NAN, |r| r.reference_relmse);
+    let _ = writeln!(
+        out,
+        "eff = 1 / (relMSE x seconds); `vs X` = eff / eff of X (above 1: fewer seconds than X to the same error); the reference's own relMSE {floor:.2e} is subtracted"
+    );
     out
 }

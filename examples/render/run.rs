@@ -172,6 +172,17 @@ pub fn render_pass(
     }
 }
 
+/// Bytes of whichever learned structures a method has.
+fn learned_bytes(
+    glt: Option<&Glt<&LightTree>>,
+    sd_tree: Option<&SdTree>,
+    field: Option<&GuidingField<&LightTree>>,
+) -> usize {
+    glt.map_or(0, |g| g.memory().total())
+        + sd_tree.map_or(0, |t| t.memory().total())
+        + field.map_or(0, |f| f.memory().total())
+}
+
 /// One finished iteration: its statistics and those of its image mean.
 struct Done {
     stats: PassStats,
@@ -195,6 +206,32 @@ pub fn render(scene: &Scene, method: Method, settings: &Settings) -> Rendered {
     render_trained(scene, method, settings).0
 }
 
+/// What a render would deliver if it stopped now: the image (the
+/// inverse-variance combination of the iterations so far, the current one
+/// included), its sample count, the render time so far (without the time
+/// spent making these samples) and the bytes of the learned structures.
+pub struct CurveSample<'i> {
+    /// Seconds of rendering so far.
+    pub seconds: f64,
+    /// Samples per pixel so far, training included.
+    pub spp: u64,
+    /// Linear RGB triples, row-major.
+    pub image: &'i [f32],
+    /// Bytes of the learned structures.
+    pub bytes: usize,
+}
+
+/// The sample counts at which a curve is recorded: 1, 2, 3, 4, 5, 7, 9,
+/// ... (each about 1.25 times the last), so points are log-spaced in
+/// samples and, for a steady renderer, in time.
+pub fn is_curve_point(spp: u64) -> bool {
+    let mut next = 1u64;
+    while next < spp {
+        next = (next as f64 * 1.25).ceil() as u64;
+    }
+    next == spp
+}
+
 /// Like [`render`], also returning the learned structures as the last
 /// iteration used them (the `light_limit` example measures them).
 pub fn render_trained<'a>(
@@ -202,7 +239,21 @@ pub fn render_trained<'a>(
     method: Method,
     settings: &Settings,
 ) -> (Rendered, Trained<'a>) {
+    render_observed(scene, method, settings, None)
+}
+
+/// [`render_trained`], calling `curve` at every [`is_curve_point`] and
+/// at the end with what the render would deliver then; the time `curve`
+/// takes is not counted as rendering time.
+pub fn render_observed<'a>(
+    scene: &'a Scene,
+    method: Method,
+    settings: &Settings,
+    mut curve: Option<&mut dyn FnMut(CurveSample<'_>)>,
+) -> (Rendered, Trained<'a>) {
     let start = Instant::now();
+    // Time spent observing the render, taken off its clock.
+    let mut paused = 0.0f64;
     let (w, h) = (settings.width, settings.height);
     let len = (3 * w * h) as usize;
     let fixed = fixed_sampler(scene, method);
@@ -245,7 +296,7 @@ pub fn render_trained<'a>(
     let mut pass_buf = vec![0.0f32; len];
     let (mut spp, mut sec_per_pass) = (0u64, 0.0f64);
     loop {
-        let elapsed = start.elapsed().as_secs_f64();
+        let elapsed = start.elapsed().as_secs_f64() - paused;
         let it = match (trained, settings.budget) {
             (true, Budget::Spp(n)) => next_iteration(k, n - spp),
             (true, Budget::Seconds(s)) => next_iteration_by_time(k, s - elapsed, sec_per_pass),
@@ -269,11 +320,12 @@ pub fn render_trained<'a>(
         let mut stats = PassStats::new(len);
         let (mut m_sum, mut m_sq) = (0.0f64, 0.0f64);
         let it_start = Instant::now();
+        let paused_before = paused;
         for pass in 0..passes {
             if let Budget::Seconds(s) = settings.budget {
-                let done = start.elapsed().as_secs_f64();
+                let done = start.elapsed().as_secs_f64() - paused;
                 let per = if pass > 0 {
-                    it_start.elapsed().as_secs_f64() / pass as f64
+                    (it_start.elapsed().as_secs_f64() - (paused - paused_before)) / pass as f64
                 } else {
                     0.0
                 };
@@ -305,12 +357,29 @@ pub fn render_trained<'a>(
             if let Budget::Spp(_) = settings.budget {
                 bar.set_position(spp);
             }
+            if let Some(observe) = curve.as_mut()
+                && is_curve_point(spp)
+            {
+                let t = Instant::now();
+                let seconds = start.elapsed().as_secs_f64() - paused;
+                let mut now = combiner.clone();
+                now.push_stats(&stats);
+                let image = now.combine();
+                let bytes = learned_bytes(glt.as_ref(), sd_tree.as_ref(), field.as_ref());
+                observe(CurveSample {
+                    seconds,
+                    spp,
+                    image: &image,
+                    bytes,
+                });
+                paused += t.elapsed().as_secs_f64();
+            }
         }
         let n = stats.passes();
         if n == 0 {
             break;
         }
-        sec_per_pass = it_start.elapsed().as_secs_f64() / n as f64;
+        sec_per_pass = (it_start.elapsed().as_secs_f64() - (paused - paused_before)) / n as f64;
         let mean = m_sum / n as f64;
         let mean_var = if n > 1 {
             ((m_sq - n as f64 * mean * mean) / ((n - 1) as f64 * n as f64)).max(0.0)
@@ -337,8 +406,18 @@ pub fn render_trained<'a>(
         k += 1;
     }
     bar.finish_and_clear();
-    let seconds = start.elapsed().as_secs_f64();
+    let seconds = start.elapsed().as_secs_f64() - paused;
     let flat = combiner.combine();
+    if let Some(observe) = curve.as_mut()
+        && !is_curve_point(spp)
+    {
+        observe(CurveSample {
+            seconds,
+            spp,
+            image: &flat,
+            bytes: learned_bytes(glt.as_ref(), sd_tree.as_ref(), field.as_ref()),
+        });
+    }
     let weights = combiner.weights();
     let mut variance = vec![Vec3::ZERO; (w * h) as usize];
     let (mut mean_error2, mut spp_final) = (0.0f64, 0u64);

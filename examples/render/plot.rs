@@ -1,0 +1,80 @@
+//! Convergence plots: relMSE against render time, log-log, one line per
+//! method, as SVG (text as SVG text: no fonts needed).
+
+use crate::report::Record;
+use plotters::prelude::*;
+use std::path::Path;
+
+/// Line colours, one per method in table order.
+const COLOURS: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+];
+
+/// Writes the relMSE-over-time plot of `records` (one scene) to `path`.
+pub fn convergence(path: &Path, scene: &str, records: &[Record]) -> Result<(), String> {
+    let points = records
+        .iter()
+        .flat_map(|r| r.curve.iter())
+        .filter(|p| p.relmse > 0.0 && p.seconds > 0.0);
+    let (mut t0, mut t1, mut e0, mut e1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for p in points {
+        t0 = t0.min(p.seconds);
+        t1 = t1.max(p.seconds);
+        e0 = e0.min(p.relmse);
+        e1 = e1.max(p.relmse);
+    }
+    if t0 >= t1 || e0 >= e1 {
+        return Err(format!("{scene}: no curve to plot"));
+    }
+    let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+    let root = SVGBackend::new(path, (720, 480)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(format!("{scene}: relMSE over time"), ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(64)
+        .build_cartesian_2d(
+            (t0 * 0.8..t1 * 1.25).log_scale(),
+            (e0 * 0.8..e1 * 1.25).log_scale(),
+        )
+        .map_err(|e| err(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc("seconds (training included)")
+        .y_desc("relMSE")
+        .draw()
+        .map_err(|e| err(&e))?;
+    for (i, r) in records.iter().enumerate() {
+        let colour = COLOURS[i % COLOURS.len()];
+        let series: Vec<(f64, f64)> = r
+            .curve
+            .iter()
+            .filter(|p| p.relmse > 0.0 && p.seconds > 0.0)
+            .map(|p| (p.seconds, p.relmse))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(
+                series.iter().copied(),
+                colour.stroke_width(2),
+            ))
+            .map_err(|e| err(&e))?
+            .label(r.method.clone())
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(2)));
+        chart
+            .draw_series(series.iter().map(|&p| Circle::new(p, 2, colour.filled())))
+            .map_err(|e| err(&e))?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| err(&e))?;
+    root.present().map_err(|e| err(&e))
+}
