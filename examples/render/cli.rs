@@ -13,7 +13,7 @@ use std::path::PathBuf;
 #[derive(Parser, Debug, Clone)]
 #[command(name = "render", version)]
 pub struct Args {
-    /// Scenes, comma separated: ring, city, pool, torus, occlusion,
+    /// Scenes, comma separated: ring, city, city-street, pool, torus, occlusion,
     /// few-lights, box, or `all`.
     #[arg(long, value_delimiter = ',', default_value = crate::scenes::DEFAULT)]
     pub scene: Vec<String>,
@@ -95,8 +95,10 @@ pub struct Args {
     /// counts light splats: finer cells pay off there.
     #[arg(long, default_value_t = 250.0)]
     pub glt_spatial_threshold: f64,
-    /// Method that renders references.
-    #[arg(long, default_value = "ppg-glt")]
+    /// Method that renders references: unbiased and unguided by default,
+    /// so that no compared guided method is measured against its own
+    /// noise (`pt-bvh`); cached per method.
+    #[arg(long, default_value = "pt-bvh")]
     pub reference_method: String,
     /// Seconds a reference renders for [default: 4x --seconds, or 80].
     #[arg(long)]

@@ -142,7 +142,7 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
     };
     let mut all = Vec::new();
     for name in &scene_names {
-        let records = run_scene(
+        let (records, trust) = run_scene(
             args,
             name,
             size,
@@ -152,6 +152,7 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
             reference_budget,
         )?;
         println!("{}", report::table(&records));
+        println!("{trust}\n");
         all.extend(records);
     }
     if let Some(path) = &args.json {
@@ -170,7 +171,7 @@ fn run_scene(
     settings: &Settings,
     reference_method: Method,
     reference_budget: Budget,
-) -> Result<Vec<Record>, String> {
+) -> Result<(Vec<Record>, String), String> {
     let t = Instant::now();
     let mut scene = scenes::build(name, size).ok_or_else(|| format!("unknown scene {name}"))?;
     if let Some(d) = args.max_depth {
@@ -206,7 +207,14 @@ fn run_scene(
     println!(
         "reference: {} ({}){}",
         reference.provenance,
-        reference::cache_stem(&args.out, &scene, settings.width, settings.height).display(),
+        reference::cache_stem(
+            &args.out,
+            &scene,
+            settings.width,
+            settings.height,
+            reference_method
+        )
+        .display(),
         if reference.cached { ", cached" } else { "" }
     );
     let exposure = film::auto_exposure(reference.mean);
@@ -306,7 +314,20 @@ fn run_scene(
             plot_path.display()
         );
     }
-    Ok(records)
+    let best = records
+        .iter()
+        .filter(|r| r.relmse > 0.0)
+        .min_by(|a, b| a.relmse.total_cmp(&b.relmse));
+    let trust = match best {
+        Some(b) => reference::trust_line(
+            b.reference_relmse,
+            b.relmse,
+            &b.method,
+            reference::seconds_of(&reference),
+        ),
+        None => "reference: no method to compare it with".to_string(),
+    };
+    Ok((records, trust))
 }
 
 fn write_outputs(dir: &Path, name: &str, r: &run::Rendered, exposure: f32) -> Result<(), String> {

@@ -24,12 +24,44 @@ pub struct Reference {
     pub cached: bool,
 }
 
-/// The cache files' common stem: `<out>/references/<scene>-<w>x<h>-<hash>`.
-pub fn cache_stem(out: &Path, scene: &Scene, width: u32, height: u32) -> PathBuf {
+/// The cache files' common stem:
+/// `<out>/references/<scene>-<w>x<h>-<method>-<hash>`.
+pub fn cache_stem(out: &Path, scene: &Scene, width: u32, height: u32, method: Method) -> PathBuf {
     out.join("references").join(format!(
-        "{}-{}x{}-{:08x}",
-        scene.name, width, height, scene.fingerprint as u32
+        "{}-{}x{}-{}-{:08x}",
+        scene.name,
+        width,
+        height,
+        method.name(),
+        scene.fingerprint as u32
     ))
+}
+
+/// A line saying how trustworthy `reference` is against the best of the
+/// compared methods' relMSE `best` (reached by `name`): its own relMSE
+/// `floor` should be below a tenth of it, and if it is not, about how
+/// long a reference would have to render (its error falls as 1 / time).
+pub fn trust_line(floor: f64, best: f64, name: &str, reference_seconds: Option<f64>) -> String {
+    let ratio = floor / best;
+    let mut line = format!(
+        "reference: own relMSE {floor:.2e} = {ratio:.3} of the best method's ({name}, {best:.2e})"
+    );
+    if ratio <= 0.1 {
+        line.push_str(": trustworthy (below 1/10)");
+    } else {
+        line.push_str(": NOT below 1/10");
+        if let Some(s) = reference_seconds {
+            let need = s * ratio / 0.1;
+            line.push_str(&format!("; about --reference-seconds {need:.0} would be"));
+        }
+    }
+    line
+}
+
+/// The seconds a reference took, from its provenance (`... <s> s`).
+pub fn seconds_of(reference: &Reference) -> Option<f64> {
+    let mut words = reference.provenance.split_whitespace().rev();
+    (words.next() == Some("s")).then(|| words.next()?.parse().ok())?
 }
 
 /// Loads the cached reference, or renders it with `method` for `budget` and
@@ -42,7 +74,7 @@ pub fn load_or_render(
     budget: Budget,
     rebuild: bool,
 ) -> Result<Reference, String> {
-    let stem = cache_stem(out, scene, settings.width, settings.height);
+    let stem = cache_stem(out, scene, settings.width, settings.height, method);
     let (img_path, var_path, meta_path) = (
         stem.with_extension("exr"),
         PathBuf::from(format!("{}-variance.exr", stem.display())),

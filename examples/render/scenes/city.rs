@@ -8,9 +8,28 @@ use crate::materials::Material;
 use crate::scene::{Effects, Scene, SceneBuilder};
 use glam::Vec3;
 
-/// Builds the city: a 20 x 20 grid of buildings (6 x 6 for
-/// [`Size::Small`]).
+/// The city seen from above its edge: most of its lights in view.
 pub fn build(size: Size) -> Scene {
+    build_with(size, View::Overview)
+}
+
+/// The city seen from its central street (`city-street`, the paper's own
+/// CITY view): the camera a few metres above the street looking down it,
+/// so each shading point sees few of the lights.
+pub fn build_street(size: Size) -> Scene {
+    build_with(size, View::Street)
+}
+
+/// Where the camera is.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum View {
+    Overview,
+    Street,
+}
+
+/// Builds the city: a 20 x 20 grid of buildings (6 x 6 for
+/// [`Size::Small`]), seen from `view`.
+fn build_with(size: Size, view: View) -> Scene {
     let blocks = match size {
         Size::Full => 20usize,
         Size::Small => 6,
@@ -143,7 +162,19 @@ pub fn build(size: Size) -> Scene {
         max_depth: 6,
         ..Effects::default()
     };
-    let eye = Vec3::new(-0.62 * extent, 0.22 * extent + 1.5, 1.25 * extent);
-    let camera = Camera::look_at(eye, Vec3::new(0.1 * extent, 0.0, 0.0), 50.0);
-    b.build("city", effects, camera, Vec::new())
+    match view {
+        View::Overview => {
+            let eye = Vec3::new(-0.62 * extent, 0.22 * extent + 1.5, 1.25 * extent);
+            let camera = Camera::look_at(eye, Vec3::new(0.1 * extent, 0.0, 0.0), 50.0);
+            b.build("city", effects, camera, Vec::new())
+        }
+        View::Street => {
+            // The street along z at x = 0 (a grid line: lamps stand on
+            // it), the eye about 0.1 units (a few metres at this scale)
+            // above it near the city's edge.
+            let eye = Vec3::new(0.0, 0.12, 0.92 * extent);
+            let camera = Camera::look_at(eye, Vec3::new(0.0, 0.1, -extent), 60.0);
+            b.build("city-street", effects, camera, Vec::new())
+        }
+    }
 }

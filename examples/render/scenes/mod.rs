@@ -25,6 +25,7 @@ pub enum Size {
 pub const NAMES: &[&str] = &[
     "ring",
     "city",
+    "city-street",
     "pool",
     "torus",
     "occlusion",
@@ -40,6 +41,7 @@ pub fn build(name: &str, size: Size) -> Option<Scene> {
     Some(match name {
         "ring" => ring::build(size),
         "city" => city::build(size),
+        "city-street" => city::build_street(size),
         "pool" => pool::build(size),
         "torus" => torus::build(size),
         "occlusion" => occlusion::build(size),
