@@ -40,9 +40,12 @@ pub struct Args {
     /// Write one JSON record per scene and method here.
     #[arg(long)]
     pub json: Option<PathBuf>,
-    /// The GLT's split threshold sigma.
-    #[arg(long, default_value_t = 0.01)]
-    pub sigma: f64,
+    /// The GLT's split threshold sigma. Several values (comma separated)
+    /// make a sigma study: each GLT method renders once per value (as
+    /// `pt-glt s=0.05`, ...), and `<out>/<scene>/sigma.svg` plots the final
+    /// relMSE and the GLT's memory against sigma (the paper's Figure 3).
+    #[arg(long, value_delimiter = ',', default_value = "0.01")]
+    pub sigma: Vec<f64>,
     /// How the GLT chooses below its cut: `power` (the paper) or
     /// `importance` (Estevez-Kulla importance of the light tree's nodes;
     /// the crate's default).

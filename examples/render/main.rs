@@ -110,7 +110,7 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
         scenes::Size::Full
     };
     let mut params = GuideParams {
-        sigma: args.sigma,
+        sigma: args.sigma[0],
         spatial_threshold: args.spatial_threshold,
         glt_spatial_threshold: args.glt_spatial_threshold,
         below_cut: args.below_cut,
@@ -222,7 +222,29 @@ fn run_scene(
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let mut records = Vec::new();
     let mut rendered = Vec::new();
-    for &method in methods {
+    // The sigma study: GLT methods once per sigma.
+    let study = args.sigma.len() > 1;
+    let runs: Vec<(Method, Option<f64>)> = methods
+        .iter()
+        .flat_map(|&m| {
+            let sigmas: Vec<Option<f64>> = if study && (m.uses_glt() || m.uses_field()) {
+                args.sigma.iter().map(|&s| Some(s)).collect()
+            } else {
+                vec![None]
+            };
+            sigmas.into_iter().map(move |s| (m, s))
+        })
+        .collect();
+    for (method, sigma) in runs {
+        let mut run_settings = settings.clone();
+        if let Some(s) = sigma {
+            run_settings.params.sigma = s;
+        }
+        let settings = &run_settings;
+        let label = match sigma {
+            Some(s) => format!("{} s={s}", method.name()),
+            None => method.name().to_string(),
+        };
         let mut curve = Vec::new();
         let mut observe = |c: run::CurveSample<'_>| {
             let image: Vec<glam::Vec3> = c
@@ -244,10 +266,11 @@ fn run_scene(
         };
         let r = run::render_observed(&scene, method, settings, observer).0;
         let e = metrics::errors(&r.image, &reference);
-        write_outputs(&dir, method.name(), &r, exposure)?;
+        write_outputs(&dir, &label.replace(' ', "-"), &r, exposure)?;
         records.push(Record {
             scene: name.to_string(),
-            method: method.name().to_string(),
+            method: label.clone(),
+            sigma: settings.params.sigma,
             width: r.width,
             height: r.height,
             spp: r.spp,
@@ -268,7 +291,7 @@ fn run_scene(
             iterations: r.iterations,
             curve,
         });
-        rendered.push((method, r, e));
+        rendered.push((label, r, e));
     }
     let mut panels = vec![sheet::Panel {
         image: &reference.image,
@@ -281,7 +304,7 @@ fn run_scene(
         panels.push(sheet::Panel {
             image: &r.image,
             lines: vec![
-                method.name().to_string(),
+                method.clone(),
                 format!("rmse {:.4}", e.rmse),
                 format!("{} spp {:.0} s", r.spp, r.seconds),
             ],
@@ -312,6 +335,14 @@ fn run_scene(
         println!(
             "{name}: convergence plot (relMSE over time) {}",
             plot_path.display()
+        );
+    }
+    if study {
+        let path = dir.join("sigma.svg");
+        plot::sigma_study(&path, name, &records)?;
+        println!(
+            "{name}: sigma study (relMSE and memory against sigma) {}",
+            path.display()
         );
     }
     let best = records

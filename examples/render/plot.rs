@@ -78,3 +78,85 @@ pub fn convergence(path: &Path, scene: &str, records: &[Record]) -> Result<(), S
         .map_err(|e| err(&e))?;
     root.present().map_err(|e| err(&e))
 }
+
+/// A number read off a record.
+type Quantity = dyn Fn(&Record) -> f64;
+
+/// Writes the sigma study of `records` (one scene; methods named
+/// `<method> s=<sigma>`) to `path`: the final relMSE and the GLT's memory
+/// (the cuts, for ppg-glt) against sigma, one line per method.
+pub fn sigma_study(path: &Path, scene: &str, records: &[Record]) -> Result<(), String> {
+    let studied: Vec<&Record> = records
+        .iter()
+        .filter(|r| r.method.contains(" s="))
+        .collect();
+    let mut methods: Vec<&str> = studied
+        .iter()
+        .filter_map(|r| r.method.split(" s=").next())
+        .collect();
+    methods.dedup();
+    let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+    let range = |f: &dyn Fn(&Record) -> f64| {
+        let v: Vec<f64> = studied.iter().map(|r| f(r)).filter(|x| *x > 0.0).collect();
+        let lo = v.iter().copied().fold(f64::MAX, f64::min);
+        let hi = v.iter().copied().fold(f64::MIN, f64::max);
+        (lo * 0.8, hi * 1.25)
+    };
+    let (s0, s1) = range(&|r| r.sigma);
+    if studied.is_empty() || s0 >= s1 {
+        return Err(format!("{scene}: no sigma study to plot"));
+    }
+    let root = SVGBackend::new(path, (960, 420)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let panels = root.split_evenly((1, 2));
+    let quantities: [(&str, &Quantity); 2] = [
+        ("relMSE at the end", &|r: &Record| r.relmse),
+        ("GLT memory (MB)", &|r: &Record| r.glt_bytes as f64 / 1e6),
+    ];
+    for (panel, (name, f)) in panels.iter().zip(quantities) {
+        let (y0, y1) = range(f);
+        let mut chart = ChartBuilder::on(panel)
+            .caption(format!("{scene}: {name} vs sigma"), ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(64)
+            .build_cartesian_2d((s0..s1).log_scale(), (y0..y1).log_scale())
+            .map_err(|e| err(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc("sigma")
+            .y_desc(name)
+            .draw()
+            .map_err(|e| err(&e))?;
+        for (i, m) in methods.iter().enumerate() {
+            let colour = COLOURS[i % COLOURS.len()];
+            let mut series: Vec<(f64, f64)> = studied
+                .iter()
+                .filter(|r| r.method.split(" s=").next() == Some(m))
+                .map(|r| (r.sigma, f(r)))
+                .filter(|p| p.1 > 0.0)
+                .collect();
+            series.sort_by(|a, b| a.0.total_cmp(&b.0));
+            chart
+                .draw_series(LineSeries::new(
+                    series.iter().copied(),
+                    colour.stroke_width(2),
+                ))
+                .map_err(|e| err(&e))?
+                .label(m.to_string())
+                .legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(2))
+                });
+            chart
+                .draw_series(series.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+                .map_err(|e| err(&e))?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| err(&e))?;
+    }
+    root.present().map_err(|e| err(&e))
+}

@@ -7,8 +7,10 @@ use std::fmt::Write as _;
 pub struct Record {
     /// Scene name.
     pub scene: String,
-    /// Method name.
+    /// Method name (with ` s=<sigma>` in a sigma study).
     pub method: String,
+    /// The GLT's sigma it ran with.
+    pub sigma: f64,
     /// Image size.
     pub width: u32,
     /// Image size.
@@ -97,6 +99,7 @@ pub fn to_json(records: &[Record]) -> String {
         let fields = [
             ("scene", string(&r.scene)),
             ("method", string(&r.method)),
+            ("sigma", num(r.sigma)),
             ("width", r.width.to_string()),
             ("height", r.height.to_string()),
             ("spp", r.spp.to_string()),
@@ -161,7 +164,7 @@ pub fn table(records: &[Record]) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "{:<11} {:>6} {:>7} {:>10} {:>10} {:>9} {:>8} {:>8} {:>17} {:>9} {:>9}",
+        "{:<16} {:>6} {:>7} {:>10} {:>10} {:>9} {:>8} {:>8} {:>17} {:>9} {:>9}",
         "method",
         "spp",
         "seconds",
@@ -177,7 +180,7 @@ pub fn table(records: &[Record]) -> String {
     for r in records {
         let _ = writeln!(
             out,
-            "{:<11} {:>6} {:>7.1} {:>10.3e} {:>10.3e} {:>9.3} {:>8} {:>8} {:>8.4} +-{:<7.4} {:>9.2} {:>9.2}",
+            "{:<16} {:>6} {:>7.1} {:>10.3e} {:>10.3e} {:>9.3} {:>8} {:>8} {:>8.4} +-{:<7.4} {:>9.2} {:>9.2}",
             r.method,
             r.spp,
             r.seconds,
