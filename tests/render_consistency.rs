@@ -247,12 +247,7 @@ fn convergence_curve_falls_as_one_over_samples() {
     };
     let mut curve: Vec<(u64, f64)> = Vec::new();
     let mut observe = |c: run::CurveSample<'_>| {
-        let image: Vec<glam::Vec3> = c
-            .image
-            .chunks_exact(3)
-            .map(glam::Vec3::from_slice)
-            .collect();
-        curve.push((c.spp, metrics::errors(&image, &reference).relmse));
+        curve.push((c.spp, metrics::relmse_of_rgb(c.image, &reference)));
     };
     run::render_observed(
         &scene,

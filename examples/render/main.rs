@@ -247,15 +247,10 @@ fn run_scene(
         };
         let mut curve = Vec::new();
         let mut observe = |c: run::CurveSample<'_>| {
-            let image: Vec<glam::Vec3> = c
-                .image
-                .chunks_exact(3)
-                .map(glam::Vec3::from_slice)
-                .collect();
             curve.push(report::CurvePoint {
                 seconds: c.seconds,
                 spp: c.spp,
-                relmse: metrics::errors(&image, &reference).relmse,
+                relmse: metrics::relmse_of_rgb(c.image, &reference),
                 bytes: c.bytes,
             });
         };

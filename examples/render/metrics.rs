@@ -23,6 +23,13 @@ pub struct Errors {
     pub relmse_floor: f64,
 }
 
+/// The relative MSE (reference noise removed) of a flat RGB image, as a
+/// render's convergence curve delivers it.
+pub fn relmse_of_rgb(rgb: &[f32], reference: &Reference) -> f64 {
+    let image: Vec<Vec3> = rgb.chunks_exact(3).map(Vec3::from_slice).collect();
+    errors(&image, reference).relmse
+}
+
 /// Errors of `image` against `reference`.
 pub fn errors(image: &[Vec3], reference: &Reference) -> Errors {
     let eps = 0.01 * reference.mean * reference.mean;

@@ -15,6 +15,28 @@ const COLOURS: [RGBColor; 6] = [
     RGBColor(140, 86, 75),
 ];
 
+/// Draws `series` as a line with points, labelled `label` in the legend.
+fn draw_line<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>,
+    series: &[(f64, f64)],
+    colour: RGBColor,
+    label: &str,
+) -> Result<(), String> {
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    chart
+        .draw_series(LineSeries::new(
+            series.iter().copied(),
+            colour.stroke_width(2),
+        ))
+        .map_err(|e| err(&e))?
+        .label(label.to_string())
+        .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(2)));
+    chart
+        .draw_series(series.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+        .map_err(|e| err(&e))?;
+    Ok(())
+}
+
 /// Writes the relMSE-over-time plot of `records` (one scene) to `path`.
 pub fn convergence(path: &Path, scene: &str, records: &[Record]) -> Result<(), String> {
     let points = records
@@ -58,17 +80,7 @@ pub fn convergence(path: &Path, scene: &str, records: &[Record]) -> Result<(), S
             .filter(|p| p.relmse > 0.0 && p.seconds > 0.0)
             .map(|p| (p.seconds, p.relmse))
             .collect();
-        chart
-            .draw_series(LineSeries::new(
-                series.iter().copied(),
-                colour.stroke_width(2),
-            ))
-            .map_err(|e| err(&e))?
-            .label(r.method.clone())
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(2)));
-        chart
-            .draw_series(series.iter().map(|&p| Circle::new(p, 2, colour.filled())))
-            .map_err(|e| err(&e))?;
+        draw_line(&mut chart, &series, colour, &r.method).map_err(|e| err(&e))?;
     }
     chart
         .configure_series_labels()
@@ -137,19 +149,7 @@ pub fn sigma_study(path: &Path, scene: &str, records: &[Record]) -> Result<(), S
                 .filter(|p| p.1 > 0.0)
                 .collect();
             series.sort_by(|a, b| a.0.total_cmp(&b.0));
-            chart
-                .draw_series(LineSeries::new(
-                    series.iter().copied(),
-                    colour.stroke_width(2),
-                ))
-                .map_err(|e| err(&e))?
-                .label(m.to_string())
-                .legend(move |(x, y)| {
-                    PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(2))
-                });
-            chart
-                .draw_series(series.iter().map(|&p| Circle::new(p, 3, colour.filled())))
-                .map_err(|e| err(&e))?;
+            draw_line(&mut chart, &series, colour, m).map_err(|e| err(&e))?;
         }
         chart
             .configure_series_labels()

@@ -5,7 +5,8 @@ use super::{FieldCell, GuidingField};
 use crate::glt::{CutConfig, CutRules, GuidingCut};
 use crate::light_tree::LightHierarchy;
 use crate::persist::{
-    FILTERS, Kind, LoadError, Reader, Writer, config_error, fingerprint, tag, untag,
+    FILTERS, Kind, LoadError, Reader, Writer, config_error, fingerprint, read_fingerprint, tag,
+    untag,
 };
 use crate::sd_tree::{SdCell, SdState};
 use crate::spatial::BinaryTree;
@@ -34,11 +35,7 @@ impl<H: LightHierarchy> GuidingField<H> {
     /// exactly like the one saved.
     pub fn from_bytes(bytes: &[u8], lights: H) -> Result<Self, LoadError> {
         let mut r = Reader::open(bytes, Kind::Field)?;
-        let saved = r.u64("light tree fingerprint")?;
-        let given = fingerprint(&lights);
-        if saved != given {
-            return Err(LoadError::LightTreeMismatch { saved, given });
-        }
+        read_fingerprint(&mut r, &lights)?;
         let sd = SdState::read(&mut r)?;
         let at = r.offset();
         let config = CutConfig::read(&mut r)?;

@@ -12,7 +12,8 @@ use crate::light_sampler::UnboundedLights;
 use crate::light_tree::LightHierarchy;
 use crate::math::{Counter, SumBuffer};
 use crate::persist::{
-    ACCUMULATION, FILTERS, Kind, LoadError, Reader, Writer, config_error, fingerprint, tag, untag,
+    ACCUMULATION, FILTERS, Kind, LoadError, Reader, Writer, config_error, fingerprint,
+    read_fingerprint, tag, untag,
 };
 use alloc::vec::Vec;
 
@@ -217,11 +218,7 @@ impl<H: LightHierarchy> Glt<H> {
     /// pmfs and learns exactly like the one saved.
     pub fn from_bytes(bytes: &[u8], tree: H) -> Result<Self, LoadError> {
         let mut r = Reader::open(bytes, Kind::Glt)?;
-        let saved = r.u64("light tree fingerprint")?;
-        let given = fingerprint(&tree);
-        if saved != given {
-            return Err(LoadError::LightTreeMismatch { saved, given });
-        }
+        read_fingerprint(&mut r, &tree)?;
         let at = r.offset();
         let config = GltConfig::read(&mut r)?;
         let guide = CutRules::new(tree, config.cut).map_err(|e| config_error(e, at))?;

@@ -7,7 +7,6 @@ use crate::math::Aabb;
 use crate::persist::{Kind, LoadError, Reader, Writer};
 use alloc::vec;
 use alloc::vec::Vec;
-use glam::Vec3;
 
 impl LightTree {
     /// The tree as bytes: a header, then the scene box, the nodes and each
@@ -30,11 +29,7 @@ impl LightTree {
     }
 
     pub(crate) fn write(&self, w: &mut Writer) {
-        for v in [self.scene.min, self.scene.max] {
-            for x in v.to_array() {
-                w.f32(x);
-            }
-        }
+        w.aabb(&self.scene);
         w.len(self.nodes.len());
         for n in &self.nodes {
             for x in n.words() {
@@ -49,16 +44,7 @@ impl LightTree {
 
     pub(crate) fn read(r: &mut Reader<'_>) -> Result<Self, LoadError> {
         let at = r.offset();
-        let mut corners = [Vec3::ZERO; 2];
-        for c in &mut corners {
-            for k in 0..3 {
-                c[k] = r.f32("light tree: scene box")?;
-            }
-        }
-        let scene = Aabb {
-            min: corners[0],
-            max: corners[1],
-        };
+        let scene = r.aabb("light tree: scene box")?;
         let count = r.len("light tree: node count", 32)?;
         let mut nodes = Vec::with_capacity(count);
         for _ in 0..count {

@@ -70,6 +70,15 @@ impl Writer {
         self.u64(x.to_bits());
     }
 
+    /// A box: min then max, three `f32` each.
+    pub(crate) fn aabb(&mut self, b: &crate::math::Aabb) {
+        for v in [b.min, b.max] {
+            for x in v.to_array() {
+                self.f32(x);
+            }
+        }
+    }
+
     /// A count, as `u64`.
     pub(crate) fn len(&mut self, n: usize) {
         self.u64(n as u64);
@@ -235,6 +244,20 @@ impl<'a> Reader<'a> {
 
     pub(crate) fn f64(&mut self, field: &'static str) -> Result<f64, LoadError> {
         Ok(f64::from_bits(self.u64(field)?))
+    }
+
+    /// A box written by [`Writer::aabb`] (not checked).
+    pub(crate) fn aabb(&mut self, field: &'static str) -> Result<crate::math::Aabb, LoadError> {
+        let mut c = [glam::Vec3::ZERO; 2];
+        for v in &mut c {
+            for k in 0..3 {
+                v[k] = self.f32(field)?;
+            }
+        }
+        Ok(crate::math::Aabb {
+            min: c[0],
+            max: c[1],
+        })
     }
 
     /// A value that `ok` accepts, else [`LoadError::Invalid`].

@@ -66,6 +66,20 @@ pub enum Kind {
     Field = 4,
 }
 
+/// Reads a saved fingerprint and checks it against `tree`'s.
+pub(crate) fn read_fingerprint<H: LightHierarchy + ?Sized>(
+    r: &mut Reader<'_>,
+    tree: &H,
+) -> Result<(), LoadError> {
+    let saved = r.u64("light tree fingerprint")?;
+    let given = fingerprint(tree);
+    if saved == given {
+        Ok(())
+    } else {
+        Err(LoadError::LightTreeMismatch { saved, given })
+    }
+}
+
 /// A fingerprint of a light hierarchy: FNV-1a 64 over every node's
 /// children, emitter, power and decoded bounds, in node order. Equal
 /// hierarchies (the same lights built the same way) have equal

@@ -7,7 +7,6 @@ use crate::math::Aabb;
 use crate::persist::{LoadError, Reader, Writer};
 use alloc::vec;
 use alloc::vec::Vec;
-use glam::Vec3;
 
 impl<T> BinaryTree<T> {
     /// Whether `other` has the same cube and the same cells (the same
@@ -19,11 +18,7 @@ impl<T> BinaryTree<T> {
     /// Writes the root cube, the node words and then each cell with
     /// `cell`.
     pub(crate) fn write(&self, w: &mut Writer, mut cell: impl FnMut(&T, &mut Writer)) {
-        for v in [self.root.min, self.root.max] {
-            for x in v.to_array() {
-                w.f32(x);
-            }
-        }
+        w.aabb(&self.root);
         w.len(self.nodes.len());
         for &n in &self.nodes {
             w.u32(n);
@@ -44,16 +39,7 @@ impl<T> BinaryTree<T> {
         mut cell: impl FnMut(&mut Reader<'_>) -> Result<T, LoadError>,
     ) -> Result<Self, LoadError> {
         let at = r.offset();
-        let mut corners = [Vec3::ZERO; 2];
-        for c in &mut corners {
-            for k in 0..3 {
-                c[k] = r.f32("spatial tree: root")?;
-            }
-        }
-        let root = Aabb {
-            min: corners[0],
-            max: corners[1],
-        };
+        let root = r.aabb("spatial tree: root")?;
         if !(root.min.is_finite() && root.max.is_finite() && root.min.cmplt(root.max).all()) {
             return Err(Reader::invalid("spatial tree: root", at));
         }
