@@ -236,8 +236,13 @@ emitters_for_list!([Emitter], alloc::vec::Vec<Emitter>);
 pub struct ShadingContext {
     /// World-space position.
     pub position: Vec3,
-    /// Unit surface normal; `None` in media or when unknown. Importance-based
-    /// samplers use it to discount lights behind the surface.
+    /// Unit surface normal on the side light is gathered from; `None` in
+    /// media, on surfaces that transmit (light arrives from both sides), or
+    /// when unknown. Importance-based samplers give lights behind it
+    /// nothing, so for an opaque surface it must face the outgoing
+    /// direction: a geometric or shading normal that points into the
+    /// surface makes every light in front of it look unreachable (see
+    /// [`ShadingContext::facing`]).
     pub normal: Option<Vec3>,
 }
 
@@ -250,12 +255,32 @@ impl ShadingContext {
         }
     }
 
-    /// A context on a surface.
+    /// A context on a surface whose `normal` already faces the side light
+    /// is gathered from (see [`ShadingContext::normal`]).
     pub fn on_surface(position: Vec3, normal: Vec3) -> Self {
         Self {
             position,
             normal: normal.try_normalize(),
         }
+    }
+
+    /// A context on an opaque surface: `normal` is flipped, if needed, to
+    /// the side of the outgoing direction `wo` (towards the viewer), as
+    /// renderers that keep normals as the mesh defines them need.
+    ///
+    /// ```
+    /// use guiding::{glam::Vec3, ShadingContext};
+    /// // A floor whose mesh normal points down, seen from above.
+    /// let ctx = ShadingContext::facing(Vec3::ZERO, -Vec3::Y, Vec3::new(0.0, 1.0, 1.0));
+    /// assert_eq!(ctx.normal, Some(Vec3::Y));
+    /// ```
+    pub fn facing(position: Vec3, normal: Vec3, wo: Vec3) -> Self {
+        let n = if normal.dot(wo) < 0.0 {
+            -normal
+        } else {
+            normal
+        };
+        Self::on_surface(position, n)
     }
 
     /// Whether the position is finite. Every [`LightSampler`] chooses
