@@ -441,8 +441,10 @@ mod sd_and_field {
         }
     }
 
-    /// Hostile rewrites of a small SD-tree and field: typed errors or
-    /// structures that keep their contracts, never a panic.
+    /// Every truncation and every single-byte change of a small saved
+    /// field: refused; the same changes with the checksum recomputed (a
+    /// hostile buffer): typed errors or fields that keep their contracts,
+    /// never a panic.
     #[test]
     fn hostile_sd_and_field_buffers_never_panic() {
         let lights: Vec<Emitter> = two_rooms().into_iter().take(4).collect();
@@ -464,10 +466,18 @@ mod sd_and_field {
         }
         let bytes = field.to_bytes();
         assert!(bytes.len() < 60_000, "{}", bytes.len());
+        for len in 0..bytes.len() {
+            assert!(GuidingField::from_bytes(&bytes[..len], &tree).is_err());
+        }
         let mut loaded = 0;
-        for i in HEADER..bytes.len() {
+        for i in 0..bytes.len() {
             let mut hostile = bytes.clone();
             hostile[i] ^= 0x41;
+            // Damaged: the checksum (or the header check) refuses it.
+            assert!(GuidingField::from_bytes(&hostile, &tree).is_err());
+            if i < HEADER {
+                continue;
+            }
             if let Ok(f) = GuidingField::from_bytes(&resealed(hostile), &tree) {
                 loaded += 1;
                 let p = rng.point(9.0);
