@@ -285,7 +285,7 @@ impl<H: LightHierarchy> Glt<H> {
         for (a, b) in cells.iter_mut().zip(other.spatial.data_slice()) {
             a.cut.merge(&b.cut);
             a.splats.merge(&b.splats);
-            a.split_count += b.split_count;
+            a.split_count = a.split_count.saturating_add(b.split_count);
         }
         self.dropped.merge(&other.dropped);
         true

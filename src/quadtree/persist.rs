@@ -42,7 +42,7 @@ fn topology_depth(links: &[Link]) -> Option<u32> {
                 if c <= n || c >= links.len() {
                     return None;
                 }
-                parents[c] += 1;
+                parents[c] = parents[c].saturating_add(1);
                 level[c] = level[n] + 1;
             }
         }
