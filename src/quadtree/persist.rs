@@ -141,3 +141,20 @@ impl DirectionalTree {
         self.links == other.links && self.nodes == other.nodes
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shared_children_are_refused_without_overflow() {
+        // 300 nodes whose four quadrants all name node 300: one child
+        // claimed 1,200 times (more than a u8 counts).
+        let mut links = vec![Link::new(300, 0b1111); 300];
+        links.extend([Link::LEAF; 4]);
+        assert_eq!(topology_depth(&links), None);
+        // A real tree: the root with two children, one with a child.
+        let ok = [Link::new(1, 0b0101), Link::new(3, 0b0001), Link::LEAF, Link::LEAF];
+        assert_eq!(topology_depth(&ok), Some(3));
+    }
+}
