@@ -154,7 +154,12 @@ mod tests {
         links.extend([Link::LEAF; 4]);
         assert_eq!(topology_depth(&links), None);
         // A real tree: the root with two children, one with a child.
-        let ok = [Link::new(1, 0b0101), Link::new(3, 0b0001), Link::LEAF, Link::LEAF];
+        let ok = [
+            Link::new(1, 0b0101),
+            Link::new(3, 0b0001),
+            Link::LEAF,
+            Link::LEAF,
+        ];
         assert_eq!(topology_depth(&ok), Some(3));
     }
 }
