@@ -15,26 +15,49 @@ const COLOURS: [RGBColor; 6] = [
     RGBColor(140, 86, 75),
 ];
 
-/// Draws `series` as a line with points, labelled `label` in the legend.
-fn draw_line<DB: DrawingBackend>(
-    chart: &mut ChartContext<'_, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>,
-    series: &[(f64, f64)],
-    colour: RGBColor,
-    label: &str,
+/// One log-log chart on `area`: `caption`, the axes' descriptions and
+/// ranges, and every `(label, points)` line with its points and a legend.
+fn log_log_chart<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    caption: &str,
+    (x_desc, x): (&str, (f64, f64)),
+    (y_desc, y): (&str, (f64, f64)),
+    lines: &[(String, Vec<(f64, f64)>)],
 ) -> Result<(), String> {
     let err = |e: &dyn std::fmt::Display| e.to_string();
-    chart
-        .draw_series(LineSeries::new(
-            series.iter().copied(),
-            colour.stroke_width(2),
-        ))
-        .map_err(|e| err(&e))?
-        .label(label.to_string())
-        .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(2)));
-    chart
-        .draw_series(series.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 18))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(64)
+        .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
         .map_err(|e| err(&e))?;
-    Ok(())
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .draw()
+        .map_err(|e| err(&e))?;
+    for (i, (label, points)) in lines.iter().enumerate() {
+        let colour = COLOURS[i % COLOURS.len()];
+        chart
+            .draw_series(LineSeries::new(
+                points.iter().copied(),
+                colour.stroke_width(2),
+            ))
+            .map_err(|e| err(&e))?
+            .label(label.clone())
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(2)));
+        chart
+            .draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+            .map_err(|e| err(&e))?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| err(&e))
 }
 
 /// Writes the relMSE-over-time plot of `records` (one scene) to `path`.
@@ -56,38 +79,24 @@ pub fn convergence(path: &Path, scene: &str, records: &[Record]) -> Result<(), S
     let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
     let root = SVGBackend::new(path, (720, 480)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(format!("{scene}: relMSE over time"), ("sans-serif", 20))
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(64)
-        .build_cartesian_2d(
-            (t0 * 0.8..t1 * 1.25).log_scale(),
-            (e0 * 0.8..e1 * 1.25).log_scale(),
-        )
-        .map_err(|e| err(&e))?;
-    chart
-        .configure_mesh()
-        .x_desc("seconds (training included)")
-        .y_desc("relMSE")
-        .draw()
-        .map_err(|e| err(&e))?;
-    for (i, r) in records.iter().enumerate() {
-        let colour = COLOURS[i % COLOURS.len()];
-        let series: Vec<(f64, f64)> = r
-            .curve
-            .iter()
-            .filter(|p| p.relmse > 0.0 && p.seconds > 0.0)
-            .map(|p| (p.seconds, p.relmse))
-            .collect();
-        draw_line(&mut chart, &series, colour, &r.method).map_err(|e| err(&e))?;
-    }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| err(&e))?;
+    let lines: Vec<(String, Vec<(f64, f64)>)> = records
+        .iter()
+        .map(|r| {
+            let points = r.curve.iter().filter(|p| p.relmse > 0.0 && p.seconds > 0.0);
+            (
+                r.method.clone(),
+                points.map(|p| (p.seconds, p.relmse)).collect(),
+            )
+        })
+        .collect();
+    log_log_chart(
+        &root,
+        &format!("{scene}: relMSE over time"),
+        ("seconds (training included)", (t0 * 0.8, t1 * 1.25)),
+        ("relMSE", (e0 * 0.8, e1 * 1.25)),
+        &lines,
+    )
+    .map_err(|e| err(&e))?;
     root.present().map_err(|e| err(&e))
 }
 
@@ -127,36 +136,28 @@ pub fn sigma_study(path: &Path, scene: &str, records: &[Record]) -> Result<(), S
     ];
     for (panel, (name, f)) in panels.iter().zip(quantities) {
         let (y0, y1) = range(f);
-        let mut chart = ChartBuilder::on(panel)
-            .caption(format!("{scene}: {name} vs sigma"), ("sans-serif", 18))
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(64)
-            .build_cartesian_2d((s0..s1).log_scale(), (y0..y1).log_scale())
-            .map_err(|e| err(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc("sigma")
-            .y_desc(name)
-            .draw()
-            .map_err(|e| err(&e))?;
-        for (i, m) in methods.iter().enumerate() {
-            let colour = COLOURS[i % COLOURS.len()];
-            let mut series: Vec<(f64, f64)> = studied
-                .iter()
-                .filter(|r| r.method.split(" s=").next() == Some(m))
-                .map(|r| (r.sigma, f(r)))
-                .filter(|p| p.1 > 0.0)
-                .collect();
-            series.sort_by(|a, b| a.0.total_cmp(&b.0));
-            draw_line(&mut chart, &series, colour, m).map_err(|e| err(&e))?;
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| err(&e))?;
+        let lines: Vec<(String, Vec<(f64, f64)>)> = methods
+            .iter()
+            .map(|m| {
+                let mine = studied
+                    .iter()
+                    .filter(|r| r.method.split(" s=").next() == Some(m));
+                let mut points: Vec<(f64, f64)> = mine
+                    .map(|r| (r.sigma, f(r)))
+                    .filter(|p| p.1 > 0.0)
+                    .collect();
+                points.sort_by(|a, b| a.0.total_cmp(&b.0));
+                (m.to_string(), points)
+            })
+            .collect();
+        log_log_chart(
+            panel,
+            &format!("{scene}: {name} vs sigma"),
+            ("sigma", (s0, s1)),
+            (name, (y0, y1)),
+            &lines,
+        )
+        .map_err(|e| err(&e))?;
     }
     root.present().map_err(|e| err(&e))
 }
