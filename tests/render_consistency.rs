@@ -243,7 +243,7 @@ fn convergence_curve_falls_as_one_over_samples() {
         image: r.image,
         variance: r.variance,
         provenance: "pt-uniform 2048 spp".into(),
-        cached: false,
+        origin: reference::Origin::Rendered,
     };
     let mut curve: Vec<(u64, f64)> = Vec::new();
     let mut observe = |c: run::CurveSample<'_>| {
@@ -271,4 +271,80 @@ fn convergence_curve_falls_as_one_over_samples() {
     let slope = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
         / pts.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
     assert!((slope + 1.0).abs() <= 0.2, "slope {slope}: {curve:?}");
+}
+
+/// A cached reference only grows: asking for more samples than the cache
+/// holds renders the rest with fresh streams and averages it in, so the
+/// extended reference has the samples asked for, about half the variance,
+/// and about half the error against an independent long render; asking
+/// for fewer loads the cache as it is.
+#[test]
+fn references_are_extended_not_rerendered() {
+    let scene = scenes::build("box", scenes::Size::Small).expect("known scene");
+    let out = std::env::temp_dir().join(format!("guiding-ref-{}", std::process::id()));
+    let settings = Settings {
+        width: 32,
+        height: 24,
+        budget: Budget::Spp(1),
+        params: GuideParams::default(),
+        seed: 3,
+        progress: false,
+        guide_files: Default::default(),
+    };
+    let get = |spp| {
+        reference::load_or_render(
+            &scene,
+            &out,
+            &settings,
+            Method::PtUniform,
+            Budget::Spp(spp),
+            false,
+        )
+        .expect("reference")
+    };
+    let variance = |r: &reference::Reference| {
+        r.variance
+            .iter()
+            .map(|v| f64::from(v.x + v.y + v.z))
+            .sum::<f64>()
+    };
+    let truth = run::render(
+        &scene,
+        Method::PtUniform,
+        &Settings {
+            budget: Budget::Spp(4096),
+            seed: 77,
+            ..settings.clone()
+        },
+    );
+    let truth = reference::Reference {
+        mean: truth.mean,
+        image: truth.image,
+        variance: truth.variance,
+        provenance: String::new(),
+        origin: reference::Origin::Rendered,
+    };
+    let short = get(64);
+    assert_eq!(short.origin, reference::Origin::Rendered);
+    let long = get(128);
+    assert_eq!(long.origin, reference::Origin::Extended(64));
+    assert!(
+        long.provenance.starts_with("pt-uniform 128 spp"),
+        "{}",
+        long.provenance
+    );
+    let ratio = variance(&long) / variance(&short);
+    assert!((0.4..0.6).contains(&ratio), "variance ratio {ratio}");
+    let (e_short, e_long) = (
+        metrics::errors(&short.image, &truth).relmse_raw,
+        metrics::errors(&long.image, &truth).relmse_raw,
+    );
+    assert!(
+        (0.35..0.7).contains(&(e_long / e_short)),
+        "relMSE {e_short} -> {e_long}"
+    );
+    let again = get(100);
+    assert_eq!(again.origin, reference::Origin::Cached);
+    assert_eq!(again.image, long.image);
+    std::fs::remove_dir_all(&out).ok();
 }

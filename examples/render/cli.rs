@@ -109,6 +109,10 @@ pub struct Args {
     /// Samples per pixel for a reference (instead of seconds).
     #[arg(long, conflicts_with = "reference_seconds")]
     pub reference_spp: Option<u64>,
+    /// Only render (or extend) the references, then stop: how a long
+    /// reference is made once and cached for later runs.
+    #[arg(long)]
+    pub reference_only: bool,
     /// Re-render references even when cached.
     #[arg(long)]
     pub rebuild_reference: bool,

@@ -26,6 +26,7 @@ mod materials;
 mod methods;
 mod metrics;
 mod plot;
+mod raster;
 mod reference;
 mod report;
 mod rng;
@@ -151,7 +152,9 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
             reference_method,
             reference_budget,
         )?;
-        println!("{}", report::table(&records));
+        if !records.is_empty() {
+            println!("{}", report::table(&records));
+        }
         println!("{trust}\n");
         all.extend(records);
     }
@@ -215,8 +218,16 @@ fn run_scene(
             reference_method
         )
         .display(),
-        if reference.cached { ", cached" } else { "" }
+        match reference.origin {
+            reference::Origin::Cached => ", cached".to_string(),
+            reference::Origin::Rendered => String::new(),
+            reference::Origin::Extended(spp) => format!(", extended from the cached {spp} spp"),
+        }
     );
+    if args.reference_only {
+        let floor = metrics::errors(&reference.image, &reference).relmse_floor;
+        return Ok((Vec::new(), format!("reference: own relMSE {floor:.2e}")));
+    }
     let exposure = film::auto_exposure(reference.mean);
     let dir = args.out.join(name);
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
@@ -306,12 +317,14 @@ fn run_scene(
         });
     }
     let sheet_path = dir.join("comparison.png");
+    let chart = |v: raster::Viewport<'_>| plot::convergence_into(v, name, &records);
     sheet::write_sheet(
         &sheet_path,
         settings.width,
         settings.height,
         exposure,
         &panels,
+        (!args.no_curve).then_some(&chart as sheet::Chart<'_>),
     )?;
     film::write_png(
         &dir.join("reference.png"),
@@ -325,19 +338,19 @@ fn run_scene(
         sheet_path.display()
     );
     if !args.no_curve {
-        let plot_path = dir.join("convergence.svg");
-        plot::convergence(&plot_path, name, &records)?;
+        let [svg, png] = plot::convergence(&dir.join("convergence"), name, &records)?;
         println!(
-            "{name}: convergence plot (relMSE over time) {}",
-            plot_path.display()
+            "{name}: convergence plot (relMSE over time) {} and {}",
+            svg.display(),
+            png.display()
         );
     }
     if study {
-        let path = dir.join("sigma.svg");
-        plot::sigma_study(&path, name, &records)?;
+        let [svg, png] = plot::sigma_study(&dir.join("sigma"), name, &records)?;
         println!(
-            "{name}: sigma study (relMSE and memory against sigma) {}",
-            path.display()
+            "{name}: sigma study (relMSE and memory against sigma) {} and {}",
+            svg.display(),
+            png.display()
         );
     }
     let best = records

@@ -1,9 +1,42 @@
 //! Convergence plots: relMSE against render time, log-log, one line per
-//! method, as SVG (text as SVG text: no fonts needed).
+//! method, each written as SVG (text as SVG text) and as PNG (text in the
+//! built-in pixel font): no font files needed.
 
+use crate::raster::{Canvas, Viewport};
 use crate::report::Record;
+use plotters::coord::Shift;
 use plotters::prelude::*;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// Draws one chart onto a drawing area of any backend.
+trait Chart {
+    /// Draws onto `area`.
+    fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String>;
+}
+
+/// Writes `chart` as `<stem>.svg` and `<stem>.png`, `size` pixels, and
+/// returns both paths.
+fn write_svg_and_png(
+    stem: &Path,
+    size: (u32, u32),
+    chart: &impl Chart,
+) -> Result<[PathBuf; 2], String> {
+    let (svg, png) = (stem.with_extension("svg"), stem.with_extension("png"));
+    let err = |p: &Path, e: &dyn std::fmt::Display| format!("{}: {e}", p.display());
+    {
+        let root = SVGBackend::new(&svg, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| err(&svg, &e))?;
+        chart.draw(&root).map_err(|e| err(&svg, &e))?;
+        root.present().map_err(|e| err(&svg, &e))?;
+    }
+    let mut canvas = Canvas::new(size.0 as usize, size.1 as usize, 255);
+    {
+        let root = Viewport::new(&mut canvas, (0, 0), size).into_drawing_area();
+        chart.draw(&root).map_err(|e| err(&png, &e))?;
+    }
+    canvas.write_png(&png)?;
+    Ok([svg, png])
+}
 
 /// Line colours, one per method in table order.
 const COLOURS: [RGBColor; 6] = [
@@ -14,6 +47,20 @@ const COLOURS: [RGBColor; 6] = [
     RGBColor(148, 103, 189),
     RGBColor(140, 86, 75),
 ];
+
+/// The label of the log axis tick at `v` on an axis spanning `range`:
+/// written by `format` when the axis spans less than a decade (few ticks),
+/// otherwise only at 1, 2 and 5 times a power of ten, so labels never
+/// crowd.
+fn tick(v: f64, range: (f64, f64), format: impl Fn(f64) -> String) -> String {
+    let mantissa = v / 10f64.powf(v.log10().floor());
+    let round = [1.0, 2.0, 5.0].iter().any(|m| (mantissa - m).abs() < 1e-6);
+    if range.1 < 10.0 * range.0 || round {
+        format(v)
+    } else {
+        String::new()
+    }
+}
 
 /// One log-log chart on `area`: `caption`, the axes' descriptions and
 /// ranges, and every `(label, points)` line with its points and a legend.
@@ -29,15 +76,17 @@ fn log_log_chart<DB: DrawingBackend>(
         .caption(caption, ("sans-serif", 18))
         .margin(12)
         .x_label_area_size(40)
-        .y_label_area_size(64)
+        .y_label_area_size(76)
         .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
         .map_err(|e| err(&e))?;
     chart
         .configure_mesh()
         .x_desc(x_desc)
         .y_desc(y_desc)
-        .x_label_formatter(&|v| format!("{v:.3}"))
-        .y_label_formatter(&|v| format!("{v:.1e}"))
+        // plotters' log axes crowd their minor grid lines near 1.
+        .light_line_style(TRANSPARENT)
+        .x_label_formatter(&|v| tick(*v, x, |v| format!("{v:.3}")))
+        .y_label_formatter(&|v| tick(*v, y, |v| format!("{v:.1e}")))
         .draw()
         .map_err(|e| err(&e))?;
     for (i, (label, points)) in lines.iter().enumerate() {
@@ -56,110 +105,150 @@ fn log_log_chart<DB: DrawingBackend>(
     }
     chart
         .configure_series_labels()
+        .position(SeriesLabelPosition::LowerLeft)
+        // plotters sizes the legend box from its own estimate of the text
+        // (0.455 em per character): 18 px fits the PNG's pixel font.
+        .label_font(("sans-serif", 18))
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .draw()
         .map_err(|e| err(&e))
 }
 
-/// Writes the relMSE-over-time plot of `records` (one scene) to `path`.
-pub fn convergence(path: &Path, scene: &str, records: &[Record]) -> Result<(), String> {
-    let points = records
-        .iter()
-        .flat_map(|r| r.curve.iter())
-        .filter(|p| p.relmse > 0.0 && p.seconds > 0.0);
-    let (mut t0, mut t1, mut e0, mut e1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for p in points {
-        t0 = t0.min(p.seconds);
-        t1 = t1.max(p.seconds);
-        e0 = e0.min(p.relmse);
-        e1 = e1.max(p.relmse);
+/// The points of `r`'s curve a log-log chart can show.
+fn curve(r: &Record) -> impl Iterator<Item = &crate::report::CurvePoint> {
+    r.curve.iter().filter(|p| p.relmse > 0.0 && p.seconds > 0.0)
+}
+
+/// The relMSE-over-time chart of one scene's records.
+pub struct Convergence<'a> {
+    /// The scene's name (the caption).
+    pub scene: &'a str,
+    /// Its records, one line each.
+    pub records: &'a [Record],
+}
+
+impl Chart for Convergence<'_> {
+    fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let (mut t0, mut t1, mut e0, mut e1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for p in self.records.iter().flat_map(curve) {
+            t0 = t0.min(p.seconds);
+            t1 = t1.max(p.seconds);
+            e0 = e0.min(p.relmse);
+            e1 = e1.max(p.relmse);
+        }
+        if t0 >= t1 || e0 >= e1 {
+            return Err(format!("{}: no curve to plot", self.scene));
+        }
+        area.fill(&WHITE).map_err(|e| e.to_string())?;
+        let lines: Vec<(String, Vec<(f64, f64)>)> = self
+            .records
+            .iter()
+            .map(|r| {
+                (
+                    r.method.clone(),
+                    curve(r).map(|p| (p.seconds, p.relmse)).collect(),
+                )
+            })
+            .collect();
+        log_log_chart(
+            area,
+            &format!("{}: relMSE over time", self.scene),
+            ("seconds (training included)", (t0 * 0.8, t1 * 1.25)),
+            ("relMSE", (e0 * 0.8, e1 * 1.25)),
+            &lines,
+        )
     }
-    if t0 >= t1 || e0 >= e1 {
-        return Err(format!("{scene}: no curve to plot"));
-    }
-    let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
-    let root = SVGBackend::new(path, (720, 480)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let lines: Vec<(String, Vec<(f64, f64)>)> = records
-        .iter()
-        .map(|r| {
-            let points = r.curve.iter().filter(|p| p.relmse > 0.0 && p.seconds > 0.0);
-            (
-                r.method.clone(),
-                points.map(|p| (p.seconds, p.relmse)).collect(),
-            )
-        })
-        .collect();
-    log_log_chart(
-        &root,
-        &format!("{scene}: relMSE over time"),
-        ("seconds (training included)", (t0 * 0.8, t1 * 1.25)),
-        ("relMSE", (e0 * 0.8, e1 * 1.25)),
-        &lines,
-    )
-    .map_err(|e| err(&e))?;
-    root.present().map_err(|e| err(&e))
+}
+
+/// Writes the relMSE-over-time plot of `records` (one scene) to
+/// `<stem>.svg` and `<stem>.png`.
+pub fn convergence(stem: &Path, scene: &str, records: &[Record]) -> Result<[PathBuf; 2], String> {
+    write_svg_and_png(stem, (720, 480), &Convergence { scene, records })
+}
+
+/// Draws the relMSE-over-time chart into `viewport` (the comparison
+/// sheet's side column).
+pub fn convergence_into(
+    viewport: Viewport<'_>,
+    scene: &str,
+    records: &[Record],
+) -> Result<(), String> {
+    Convergence { scene, records }.draw(&viewport.into_drawing_area())
 }
 
 /// A number read off a record.
 type Quantity = dyn Fn(&Record) -> f64;
 
+/// The sigma study's two charts (final relMSE and the GLT's memory
+/// against sigma) side by side.
+struct SigmaStudy<'a> {
+    scene: &'a str,
+    /// The records of the study (methods named `<method> s=<sigma>`).
+    studied: Vec<&'a Record>,
+}
+
+impl SigmaStudy<'_> {
+    /// The range of `f` over the studied records, padded for the axes.
+    fn range(&self, f: &Quantity) -> (f64, f64) {
+        let v = self.studied.iter().map(|r| f(r)).filter(|x| *x > 0.0);
+        let (lo, hi) = v.fold((f64::MAX, f64::MIN), |(lo, hi), x| (lo.min(x), hi.max(x)));
+        (lo * 0.8, hi * 1.25)
+    }
+}
+
+impl Chart for SigmaStudy<'_> {
+    fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let mut methods: Vec<&str> = self
+            .studied
+            .iter()
+            .filter_map(|r| r.method.split(" s=").next())
+            .collect();
+        methods.dedup();
+        let (s0, s1) = self.range(&|r| r.sigma);
+        if self.studied.is_empty() || s0 >= s1 {
+            return Err(format!("{}: no sigma study to plot", self.scene));
+        }
+        let quantities: [(&str, &Quantity); 2] = [
+            ("relMSE at the end", &|r: &Record| r.relmse),
+            ("GLT memory (MB)", &|r: &Record| r.glt_bytes as f64 / 1e6),
+        ];
+        for (panel, (name, f)) in area.split_evenly((1, 2)).iter().zip(quantities) {
+            let lines: Vec<(String, Vec<(f64, f64)>)> = methods
+                .iter()
+                .map(|m| {
+                    let mine = self
+                        .studied
+                        .iter()
+                        .filter(|r| r.method.split(" s=").next() == Some(m));
+                    let mut points: Vec<(f64, f64)> = mine
+                        .map(|r| (r.sigma, f(r)))
+                        .filter(|p| p.1 > 0.0)
+                        .collect();
+                    points.sort_by(|a, b| a.0.total_cmp(&b.0));
+                    (m.to_string(), points)
+                })
+                .collect();
+            log_log_chart(
+                panel,
+                &format!("{}: {name} vs sigma", self.scene),
+                ("sigma", (s0, s1)),
+                (name, self.range(f)),
+                &lines,
+            )?;
+        }
+        Ok(())
+    }
+}
+
 /// Writes the sigma study of `records` (one scene; methods named
-/// `<method> s=<sigma>`) to `path`: the final relMSE and the GLT's memory
-/// (the cuts, for ppg-glt) against sigma, one line per method.
-pub fn sigma_study(path: &Path, scene: &str, records: &[Record]) -> Result<(), String> {
-    let studied: Vec<&Record> = records
+/// `<method> s=<sigma>`) to `<stem>.svg` and `<stem>.png`: the final
+/// relMSE and the GLT's memory (the cuts, for ppg-glt) against sigma, one
+/// line per method.
+pub fn sigma_study(stem: &Path, scene: &str, records: &[Record]) -> Result<[PathBuf; 2], String> {
+    let studied = records
         .iter()
         .filter(|r| r.method.contains(" s="))
         .collect();
-    let mut methods: Vec<&str> = studied
-        .iter()
-        .filter_map(|r| r.method.split(" s=").next())
-        .collect();
-    methods.dedup();
-    let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
-    let range = |f: &dyn Fn(&Record) -> f64| {
-        let v: Vec<f64> = studied.iter().map(|r| f(r)).filter(|x| *x > 0.0).collect();
-        let lo = v.iter().copied().fold(f64::MAX, f64::min);
-        let hi = v.iter().copied().fold(f64::MIN, f64::max);
-        (lo * 0.8, hi * 1.25)
-    };
-    let (s0, s1) = range(&|r| r.sigma);
-    if studied.is_empty() || s0 >= s1 {
-        return Err(format!("{scene}: no sigma study to plot"));
-    }
-    let root = SVGBackend::new(path, (960, 420)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let panels = root.split_evenly((1, 2));
-    let quantities: [(&str, &Quantity); 2] = [
-        ("relMSE at the end", &|r: &Record| r.relmse),
-        ("GLT memory (MB)", &|r: &Record| r.glt_bytes as f64 / 1e6),
-    ];
-    for (panel, (name, f)) in panels.iter().zip(quantities) {
-        let (y0, y1) = range(f);
-        let lines: Vec<(String, Vec<(f64, f64)>)> = methods
-            .iter()
-            .map(|m| {
-                let mine = studied
-                    .iter()
-                    .filter(|r| r.method.split(" s=").next() == Some(m));
-                let mut points: Vec<(f64, f64)> = mine
-                    .map(|r| (r.sigma, f(r)))
-                    .filter(|p| p.1 > 0.0)
-                    .collect();
-                points.sort_by(|a, b| a.0.total_cmp(&b.0));
-                (m.to_string(), points)
-            })
-            .collect();
-        log_log_chart(
-            panel,
-            &format!("{scene}: {name} vs sigma"),
-            ("sigma", (s0, s1)),
-            (name, (y0, y1)),
-            &lines,
-        )
-        .map_err(|e| err(&e))?;
-    }
-    root.present().map_err(|e| err(&e))
+    write_svg_and_png(stem, (960, 420), &SigmaStudy { scene, studied })
 }

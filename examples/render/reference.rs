@@ -20,8 +20,8 @@ pub struct Reference {
     /// Method, samples per pixel and seconds it took (from the cache's
     /// metadata when loaded).
     pub provenance: String,
-    /// True when it came from the cache.
-    pub cached: bool,
+    /// Whether it was cached, rendered or extended now.
+    pub origin: Origin,
 }
 
 /// The cache files' common stem:
@@ -64,8 +64,63 @@ pub fn seconds_of(reference: &Reference) -> Option<f64> {
     (words.next() == Some("s")).then(|| words.next()?.parse().ok())?
 }
 
-/// Loads the cached reference, or renders it with `method` for `budget` and
-/// caches it. `rebuild` ignores the cache.
+/// Where a reference came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Origin {
+    /// Loaded from the cache as it was.
+    Cached,
+    /// Rendered now (no usable cache).
+    Rendered,
+    /// The cache held this many samples per pixel, fewer than asked for:
+    /// more were rendered with fresh random streams and averaged in.
+    Extended(u64),
+}
+
+/// A cached reference as read from disk.
+struct Cache {
+    image: Vec<Vec3>,
+    variance: Vec<Vec3>,
+    spp: u64,
+    seconds: f64,
+}
+
+/// The samples per pixel and seconds in a provenance line
+/// `<method> <spp> spp <seconds> s`.
+fn parse_provenance(line: &str) -> Option<(u64, f64)> {
+    let w: Vec<&str> = line.split_whitespace().collect();
+    match w[..] {
+        [_, spp, "spp", seconds, "s"] => Some((spp.parse().ok()?, seconds.parse().ok()?)),
+        _ => None,
+    }
+}
+
+fn read_cache(img: &Path, var: &Path, meta: &Path, width: u32, height: u32) -> Option<Cache> {
+    let (w, h, image) = read_exr(img).ok()?;
+    let (vw, vh, variance) = read_exr(var).ok()?;
+    let (spp, seconds) = parse_provenance(std::fs::read_to_string(meta).ok()?.trim())?;
+    ((w, h) == (width, height) && (vw, vh) == (w, h)).then_some(Cache {
+        image,
+        variance,
+        spp,
+        seconds,
+    })
+}
+
+/// What is still to render for `budget` when the cache holds `spp`
+/// samples per pixel rendered in `seconds` (`None`: the cache suffices;
+/// a cache within 2% of a time budget counts as meeting it).
+fn still_to_render(budget: Budget, spp: u64, seconds: f64) -> Option<Budget> {
+    match budget {
+        Budget::Spp(n) => (n > spp).then(|| Budget::Spp(n - spp)),
+        Budget::Seconds(s) => (seconds < 0.98 * s).then_some(Budget::Seconds(s - seconds)),
+    }
+}
+
+/// Loads the cached reference if it holds at least `budget`; otherwise
+/// renders what is missing with `method` (fresh random streams, so every
+/// part is independent), averages it with the cache weighted by samples
+/// per pixel, and writes the result back. A reference therefore only
+/// grows: asking for a longer one extends it. `rebuild` ignores the cache.
 pub fn load_or_render(
     scene: &Scene,
     out: &Path,
@@ -80,36 +135,72 @@ pub fn load_or_render(
         PathBuf::from(format!("{}-variance.exr", stem.display())),
         stem.with_extension("txt"),
     );
-    if !rebuild && img_path.exists() && var_path.exists() {
-        let (w, h, image) = read_exr(&img_path)?;
-        let (vw, vh, variance) = read_exr(&var_path)?;
-        if (w, h) == (settings.width, settings.height) && (vw, vh) == (w, h) {
-            let provenance = std::fs::read_to_string(&meta_path).unwrap_or_default();
-            let mean = mean_luminance(&image);
-            return Ok(Reference {
-                image,
-                variance,
-                mean,
-                provenance: provenance.trim().to_string(),
-                cached: true,
-            });
-        }
-    }
+    let cache = if rebuild {
+        None
+    } else {
+        read_cache(
+            &img_path,
+            &var_path,
+            &meta_path,
+            settings.width,
+            settings.height,
+        )
+    };
+    let (have_spp, have_seconds) = cache.as_ref().map_or((0, 0.0), |c| (c.spp, c.seconds));
+    let Some(more) = still_to_render(budget, have_spp, have_seconds) else {
+        let c = cache.expect("a budget is only met by a cache");
+        return Ok(Reference {
+            mean: mean_luminance(&c.image),
+            image: c.image,
+            variance: c.variance,
+            provenance: format!("{} {} spp {:.1} s", method.name(), c.spp, c.seconds),
+            origin: Origin::Cached,
+        });
+    };
     let mut s = settings.clone();
-    s.budget = budget;
-    s.seed ^= 0x0005_eed0_f4ef;
+    s.budget = more;
+    // Each part's streams depend on the samples already held, so an
+    // extension never repeats a part (the first part keeps the seed the
+    // cache has always used).
+    s.seed ^= 0x0005_eed0_f4ef
+        ^ if have_spp == 0 {
+            0
+        } else {
+            crate::rng::mix64(have_spp)
+        };
     let r = render(scene, method, &s);
+    let (spp, seconds, image, variance, origin) = match cache {
+        Some(c) if c.spp > 0 && r.spp > 0 => {
+            let (n0, n1) = (c.spp as f32, r.spp as f32);
+            let n = n0 + n1;
+            let image = c
+                .image
+                .iter()
+                .zip(&r.image)
+                .map(|(a, b)| (*a * n0 + *b * n1) / n);
+            let variance = c.variance.iter().zip(&r.variance);
+            let variance = variance.map(|(a, b)| (*a * (n0 * n0) + *b * (n1 * n1)) / (n * n));
+            (
+                c.spp + r.spp,
+                c.seconds + r.seconds,
+                image.collect(),
+                variance.collect(),
+                Origin::Extended(c.spp),
+            )
+        }
+        _ => (r.spp, r.seconds, r.image, r.variance, Origin::Rendered),
+    };
     std::fs::create_dir_all(stem.parent().unwrap_or(out)).map_err(|e| e.to_string())?;
-    write_exr(&img_path, r.width, r.height, &r.image)?;
-    write_exr(&var_path, r.width, r.height, &r.variance)?;
-    let provenance = format!("{} {} spp {:.1} s", method.name(), r.spp, r.seconds);
+    write_exr(&img_path, r.width, r.height, &image)?;
+    write_exr(&var_path, r.width, r.height, &variance)?;
+    let provenance = format!("{} {spp} spp {seconds:.1} s", method.name());
     std::fs::write(&meta_path, format!("{provenance}\n")).map_err(|e| e.to_string())?;
     Ok(Reference {
-        mean: r.mean,
-        image: r.image,
-        variance: r.variance,
+        mean: mean_luminance(&image),
+        image,
+        variance,
         provenance,
-        cached: false,
+        origin,
     })
 }
 
