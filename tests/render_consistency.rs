@@ -31,6 +31,8 @@ mod methods;
 mod metrics;
 #[path = "../examples/render/reference.rs"]
 mod reference;
+#[path = "../examples/render/report.rs"]
+mod report;
 #[path = "../examples/render/rng.rs"]
 mod rng;
 #[path = "../examples/render/run.rs"]

@@ -103,7 +103,8 @@ pub struct Args {
     /// noise (`pt-bvh`); cached per method.
     #[arg(long, default_value = "pt-bvh")]
     pub reference_method: String,
-    /// Seconds a reference renders for [default: 4x --seconds, or 80].
+    /// Seconds a reference renders for [default: 25x --seconds, or 80]; a
+    /// cached shorter reference is extended to this.
     #[arg(long)]
     pub reference_seconds: Option<f64>,
     /// Samples per pixel for a reference (instead of seconds).

@@ -4,6 +4,7 @@
 
 use crate::film::{read_exr, write_exr};
 use crate::methods::Method;
+use crate::report::Record;
 use crate::run::{Budget, Settings, render};
 use crate::scene::Scene;
 use glam::Vec3;
@@ -38,22 +39,33 @@ pub fn cache_stem(out: &Path, scene: &Scene, width: u32, height: u32, method: Me
 }
 
 /// A line saying how trustworthy `reference` is against the best of the
-/// compared methods' relMSE `best` (reached by `name`): its own relMSE
-/// `floor` should be below a tenth of it, and if it is not, about how
-/// long a reference would have to render (its error falls as 1 / time).
-pub fn trust_line(floor: f64, best: f64, name: &str, reference_seconds: Option<f64>) -> String {
-    let ratio = floor / best;
+/// compared methods, `best`: the reference's own relMSE `floor` should be
+/// below a tenth of `best`'s at the end of its curve. If it is not, the
+/// line says up to when on the curves it is (where `best`'s relMSE is
+/// still ten times `floor`) and about how long a reference would have to
+/// render (its error falls as 1 / time).
+pub fn trust_line(floor: f64, best: &Record, reference_seconds: Option<f64>) -> String {
+    let ratio = floor / best.relmse;
     let mut line = format!(
-        "reference: own relMSE {floor:.2e} = {ratio:.3} of the best method's ({name}, {best:.2e})"
+        "reference: own relMSE {floor:.2e} = {ratio:.3} of the best method's ({}, {:.2e})",
+        best.method, best.relmse
     );
     if ratio <= 0.1 {
         line.push_str(": trustworthy (below 1/10)");
-    } else {
-        line.push_str(": NOT below 1/10");
-        if let Some(s) = reference_seconds {
-            let need = s * ratio / 0.1;
-            line.push_str(&format!("; about --reference-seconds {need:.0} would be"));
-        }
+        return line;
+    }
+    line.push_str(": NOT below 1/10");
+    if let Some(p) = best
+        .curve
+        .iter()
+        .take_while(|p| p.relmse >= 10.0 * floor)
+        .last()
+    {
+        line.push_str(&format!(" (it is up to {:.2} s of the curves)", p.seconds));
+    }
+    if let Some(s) = reference_seconds {
+        let need = s * ratio / 0.1;
+        line.push_str(&format!("; about --reference-seconds {need:.0} would be"));
     }
     line
 }

@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 
 /// One scene + method result.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct Record {
     /// Scene name.
     pub scene: String,
@@ -171,7 +171,7 @@ pub fn table(records: &[Record]) -> String {
         "RMSE",
         "relMSE",
         "eff",
-        "vs pt-u",
+        "vs bvh",
         "vs ppg",
         "mean +- err",
         "SD MB",
@@ -187,7 +187,7 @@ pub fn table(records: &[Record]) -> String {
             r.rmse,
             r.relmse,
             r.efficiency,
-            relative(records, r, "pt-uniform"),
+            relative(records, r, "pt-bvh"),
             relative(records, r, "ppg"),
             r.mean,
             r.mean_error,
