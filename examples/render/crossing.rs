@@ -26,27 +26,6 @@ pub struct Crossing {
     pub end_ratio: f64,
 }
 
-/// `ln relMSE` of `r`'s curve at `ln t`, linear in log-log between the
-/// recorded points (`None` outside the curve).
-fn log_relmse_at(r: &Record, log_t: f64) -> Option<f64> {
-    let pts: Vec<(f64, f64)> = r
-        .curve
-        .iter()
-        .filter(|p| p.seconds > 0.0 && p.relmse > 0.0)
-        .map(|p| (p.seconds.ln(), p.relmse.ln()))
-        .collect();
-    let k = pts
-        .windows(2)
-        .position(|w| w[0].0 <= log_t && log_t <= w[1].0)?;
-    let ((t0, e0), (t1, e1)) = (pts[k], pts[k + 1]);
-    let f = if t1 > t0 {
-        (log_t - t0) / (t1 - t0)
-    } else {
-        0.0
-    };
-    Some(e0 + f * (e1 - e0))
-}
-
 /// The crossing of `guided` with `unguided` on 400 log-spaced times over
 /// the stretch both curves cover (`None` without two curves that overlap).
 pub fn crossing(guided: &Record, unguided: &Record) -> Option<Crossing> {
@@ -65,7 +44,7 @@ pub fn crossing(guided: &Record, unguided: &Record) -> Option<Crossing> {
     let times = (0..=STEPS).map(|i| (lo + (hi - lo) * i as f64 / STEPS as f64).clamp(lo, hi));
     let mut from = Some(a0.max(b0));
     for t in times {
-        let (a, b) = (log_relmse_at(guided, t)?, log_relmse_at(unguided, t)?);
+        let (a, b) = (guided.log_relmse_at(t)?, unguided.log_relmse_at(t)?);
         if a >= b {
             from = None;
         } else if from.is_none() {

@@ -161,6 +161,7 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
         )?;
         if !records.is_empty() {
             println!("{}", report::table(&records));
+            print!("{}", report::curve_table(&records));
         }
         println!("{trust}\n");
         all.extend(records);

@@ -52,6 +52,29 @@ pub struct Record {
     pub curve: Vec<CurvePoint>,
 }
 
+impl Record {
+    /// `ln relMSE` of the curve at `ln t` (`log_t`), linear in log-log
+    /// between the recorded points (`None` outside the curve).
+    pub fn log_relmse_at(&self, log_t: f64) -> Option<f64> {
+        let pts: Vec<(f64, f64)> = self
+            .curve
+            .iter()
+            .filter(|p| p.seconds > 0.0 && p.relmse > 0.0)
+            .map(|p| (p.seconds.ln(), p.relmse.ln()))
+            .collect();
+        let k = pts
+            .windows(2)
+            .position(|w| w[0].0 <= log_t && log_t <= w[1].0)?;
+        let ((t0, e0), (t1, e1)) = (pts[k], pts[k + 1]);
+        let f = if t1 > t0 {
+            (log_t - t0) / (t1 - t0)
+        } else {
+            0.0
+        };
+        Some(e0 + f * (e1 - e0))
+    }
+}
+
 /// One point of a convergence curve.
 #[derive(Clone, Copy, Debug)]
 pub struct CurvePoint {
@@ -200,5 +223,54 @@ pub fn table(records: &[Record]) -> String {
         out,
         "eff = 1 / (relMSE x seconds); `vs X` = eff / eff of X (above 1: fewer seconds than X to the same error); the reference's own relMSE {floor:.2e} is subtracted"
     );
+    out
+}
+
+/// The times a curve table shows: 1, 3, 10, 30, 100, 300, ... seconds.
+fn table_times(end: f64) -> Vec<f64> {
+    let times = (0..).map(|k| {
+        if k % 2 == 0 {
+            10f64.powi(k / 2)
+        } else {
+            3.0 * 10f64.powi(k / 2)
+        }
+    });
+    times.take_while(|&t| t < end * 0.999).collect()
+}
+
+/// A plain-text table of the convergence curves of one scene's records:
+/// the relMSE each method would deliver at 1, 3, 10, 30, ... seconds
+/// (log-log interpolation of its curve) and at the end, with the samples
+/// and memory then. Empty without curves.
+pub fn curve_table(records: &[Record]) -> String {
+    let end = records.iter().map(|r| r.seconds).fold(0.0, f64::max);
+    if records.iter().all(|r| r.curve.is_empty()) {
+        return String::new();
+    }
+    let times = table_times(end);
+    let mut out = String::new();
+    let _ = write!(out, "{:<16}", "relMSE at");
+    for t in &times {
+        let _ = write!(out, " {:>9}", format!("{t} s"));
+    }
+    let _ = writeln!(out, " {:>9} {:>7} {:>8}", "end", "spp", "MB");
+    for r in records {
+        let _ = write!(out, "{:<16}", r.method);
+        for t in &times {
+            match r.log_relmse_at(t.ln()) {
+                Some(e) => write!(out, " {:>9.3e}", e.exp()),
+                None => write!(out, " {:>9}", "-"),
+            }
+            .ok();
+        }
+        let bytes = r.curve.last().map_or(0, |p| p.bytes);
+        let _ = writeln!(
+            out,
+            " {:>9.3e} {:>7} {:>8.1}",
+            r.relmse,
+            r.spp,
+            bytes as f64 / 1e6
+        );
+    }
     out
 }
