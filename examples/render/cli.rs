@@ -103,7 +103,7 @@ pub struct Args {
     /// noise (`pt-bvh`); cached per method.
     #[arg(long, default_value = "pt-bvh")]
     pub reference_method: String,
-    /// Seconds a reference renders for [default: 25x --seconds, or 80]; a
+    /// Seconds a reference renders for [default: 40x --seconds, or 80]; a
     /// cached shorter reference is extended to this.
     #[arg(long)]
     pub reference_seconds: Option<f64>,
