@@ -38,15 +38,35 @@ fn write_svg_and_png(
     Ok([svg, png])
 }
 
-/// Line colours, one per method in table order.
-const COLOURS: [RGBColor; 6] = [
+/// Line colours, one per method in table order (a sigma study draws
+/// seven lines).
+const COLOURS: [RGBColor; 10] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
     RGBColor(214, 39, 40),
     RGBColor(148, 103, 189),
     RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
 ];
+
+/// A log axis range `(lo, hi)` with `lo` lowered to the power of ten
+/// below it when that costs little or when the range holds no power of
+/// ten: plotters places a log axis's ticks from the first power of ten in
+/// the range upwards, so without one the axis has no tick at all. (Just
+/// below the power of ten: plotters finds its first tick by rounding a
+/// logarithm up, which at the power itself may round past it.)
+fn with_decade(lo: f64, hi: f64) -> (f64, f64) {
+    let decade = 10f64.powf(lo.log10().floor());
+    if lo < 2.5 * decade || 10.0 * decade > hi {
+        (decade * 0.999, hi)
+    } else {
+        (lo, hi)
+    }
+}
 
 /// The label of the log axis tick at `v` on an axis spanning `range`:
 /// written by `format` when the axis spans less than a decade (few ticks),
@@ -77,7 +97,16 @@ fn log_log_chart<DB: DrawingBackend>(
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(76)
-        .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
+        .build_cartesian_2d(
+            {
+                let (lo, hi) = with_decade(x.0, x.1);
+                (lo..hi).log_scale()
+            },
+            {
+                let (lo, hi) = with_decade(y.0, y.1);
+                (lo..hi).log_scale()
+            },
+        )
         .map_err(|e| err(&e))?;
     chart
         .configure_mesh()
