@@ -367,7 +367,7 @@ fn run_scene(
         .filter(|r| r.relmse > 0.0)
         .min_by(|a, b| a.relmse.total_cmp(&b.relmse));
     let trust = match best {
-        Some(b) => reference::trust_line(b.reference_relmse, b, reference::seconds_of(&reference)),
+        Some(b) => reference::trust_line(b, reference::seconds_of(&reference)),
         None => "reference: no method to compare it with".to_string(),
     };
     let trust = format!(

@@ -39,12 +39,14 @@ pub fn cache_stem(out: &Path, scene: &Scene, width: u32, height: u32, method: Me
 }
 
 /// A line saying how trustworthy `reference` is against the best of the
-/// compared methods, `best`: the reference's own relMSE `floor` should be
-/// below a tenth of `best`'s at the end of its curve. If it is not, the
+/// compared methods, `best`: the reference's own relMSE (`best`'s
+/// `reference_relmse`) should be below a tenth of `best`'s at the end of
+/// its curve. If it is not, the
 /// line says up to when on the curves it is (where `best`'s relMSE is
 /// still ten times `floor`) and about how long a reference would have to
 /// render (its error falls as 1 / time).
-pub fn trust_line(floor: f64, best: &Record, reference_seconds: Option<f64>) -> String {
+pub fn trust_line(best: &Record, reference_seconds: Option<f64>) -> String {
+    let floor = best.reference_relmse;
     let ratio = floor / best.relmse;
     let mut line = format!(
         "reference: own relMSE {floor:.2e} = {ratio:.3} of the best method's ({}, {:.2e})",
@@ -70,10 +72,9 @@ pub fn trust_line(floor: f64, best: &Record, reference_seconds: Option<f64>) -> 
     line
 }
 
-/// The seconds a reference took, from its provenance (`... <s> s`).
+/// The seconds a reference took, from its provenance.
 pub fn seconds_of(reference: &Reference) -> Option<f64> {
-    let mut words = reference.provenance.split_whitespace().rev();
-    (words.next() == Some("s")).then(|| words.next()?.parse().ok())?
+    parse_provenance(&reference.provenance).map(|(_, seconds)| seconds)
 }
 
 /// Where a reference came from.
