@@ -242,3 +242,50 @@ pub fn gamma_q(a: f64, x: f64) -> f64 {
         front * h
     }
 }
+
+/// The standard normal quantile of 1 - 1e-4: a Wilson–Hilferty z above it
+/// is a p-value below 1e-4.
+pub const Z_P_1E4: f64 = 3.719_016_5;
+
+/// Wilson–Hilferty z-score of `observed` counts against probabilities
+/// `probs`, pooling bins expected below 5; `None` when a light with pmf 0
+/// was drawn. Returns (z, degrees of freedom).
+pub fn chi_square_z(observed: &[u64], probs: &[f64]) -> Option<(f64, usize)> {
+    let draws: u64 = observed.iter().sum();
+    let mut bins = Vec::new();
+    for (&o, &p) in observed.iter().zip(probs) {
+        if p <= 0.0 {
+            if o > 0 {
+                return None;
+            }
+            continue;
+        }
+        bins.push((draws as f64 * p, o as f64));
+    }
+    bins.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut pooled = (0.0, 0.0);
+    let mut kept: Vec<(f64, f64)> = Vec::new();
+    for (e, o) in bins {
+        if e < 5.0 {
+            pooled = (pooled.0 + e, pooled.1 + o);
+        } else {
+            kept.push((e, o));
+        }
+    }
+    if pooled.0 > 0.0 {
+        if pooled.0 >= 5.0 || kept.is_empty() {
+            kept.push(pooled);
+        } else {
+            kept[0] = (kept[0].0 + pooled.0, kept[0].1 + pooled.1);
+        }
+    }
+    let k = kept.len().saturating_sub(1);
+    if k == 0 {
+        return Some((f64::NEG_INFINITY, 0));
+    }
+    let chi2: f64 = kept.iter().map(|(e, o)| (o - e) * (o - e) / e).sum();
+    let k = k as f64;
+    let v = 2.0 / (9.0 * k);
+    let z = ((chi2 / k).cbrt() - (1.0 - v)) / v.sqrt();
+    Some((z, kept.len() - 1))
+}
