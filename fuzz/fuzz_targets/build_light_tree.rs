@@ -4,4 +4,6 @@
 #[path = "../checks.rs"]
 mod checks;
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| checks::build::build_light_tree(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    checks::build::build_light_tree(data);
+});
