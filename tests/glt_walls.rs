@@ -174,9 +174,9 @@ fn dim_room_ratio(config: CutConfig, filter: SpatialFilter) -> f64 {
 }
 
 /// The dim room learns its own lights with the default splat: its
-/// variance is at most 1/1000 of power sampling's (the bar is
-/// 1/10; nearest splats give about 6e-6 here), with and without
-/// modulation.
+/// variance is at most 2e-5 of power sampling's (the bar was 1/10;
+/// nearest splats give 6.3e-6 without modulation and 3.9e-6 with it, so
+/// a change that triples either fails here), with and without modulation.
 #[test]
 fn dim_room_beside_bright_rooms_learns_its_own_lights() {
     let filter = GltConfig::default().filter;
@@ -187,7 +187,7 @@ fn dim_room_beside_bright_rooms_learns_its_own_lights() {
         };
         let ratio = dim_room_ratio(config, filter);
         assert!(
-            ratio <= 1e-3,
+            ratio <= 2e-5,
             "{modulation:?}: GLT / power variance {ratio}"
         );
     }

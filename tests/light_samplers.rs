@@ -1215,23 +1215,27 @@ fn samplers_are_sync_and_work_across_threads() {
     assert_sync::<ImportanceTreeSampler<&'static LightTree>>();
     assert_sync::<WithUnbounded<PowerSampler>>();
 
+    // Two threads answer the interleaved halves of 2000 queries; together
+    // they give what one thread gives alone, for every sampler.
     let emitters = fit_scene(200, 8);
     let tree = LightTree::build(&emitters, BuildHeuristic::Sarh).unwrap();
-    let s = ImportanceTreeSampler::new(&tree);
     let ctx = ShadingContext::at(Vec3::new(0.0, 5.0, 0.0));
-    let results: Vec<Vec<Option<_>>> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..2)
-            .map(|_| {
-                scope.spawn(|| {
-                    (0..1000)
-                        .map(|k| s.sample(&ctx, k as f32 / 1000.0))
-                        .collect()
-                })
-            })
-            .collect();
-        handles.into_iter().map(|h| h.join().unwrap()).collect()
-    });
-    assert_eq!(results[0], results[1]);
+    for (name, s) in all_samplers(&emitters, &tree, sun_and_sky(0.2)) {
+        let query = |k: usize| {
+            let x = s.sample(&ctx, k as f32 / 2000.0);
+            (x, x.map(|x| s.pmf(&ctx, x.light)))
+        };
+        let serial: Vec<_> = (0..2000).map(query).collect();
+        let halves: Vec<Vec<_>> = std::thread::scope(|scope| {
+            let handles: Vec<_> = (0..2)
+                .map(|t| scope.spawn(move || (t..2000).step_by(2).map(query).collect()))
+                .collect();
+            handles.into_iter().map(|h| h.join().unwrap()).collect()
+        });
+        for (k, want) in serial.iter().enumerate() {
+            assert_eq!(halves[k % 2][k / 2], *want, "{name}: query {k}");
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------
