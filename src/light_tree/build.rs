@@ -158,6 +158,51 @@ pub(super) fn build<E: Emitters + ?Sized>(
     emitters: &E,
     heuristic: BuildHeuristic,
 ) -> Result<LightTree, BuildError> {
+    build_with(emitters, heuristic, best_binned_split)
+}
+
+/// Chooses the split of a node's items: the (axis, last left bucket) of the
+/// cheapest binned split, or `None`; fills `scratch` with each item's bucket
+/// on every axis that can be split. [`best_binned_split`] in the crate; the
+/// tests compare it with a straightforward implementation.
+type ChooseSplit = fn(
+    &[Item],
+    &mut [[u8; 3]],
+    &mut OrientationMemo,
+    BuildHeuristic,
+    &Aabb,
+    &Aabb,
+) -> Option<(usize, usize)>;
+
+/// The fast binned choice: one pass over the items for all three axes
+/// ([`best_bucket_split`]), two-item nodes without buckets
+/// ([`best_pair_split`]).
+fn best_binned_split(
+    items: &[Item],
+    scratch: &mut [[u8; 3]],
+    memo: &mut OrientationMemo,
+    heuristic: BuildHeuristic,
+    centroids: &Aabb,
+    bounds: &Aabb,
+) -> Option<(usize, usize)> {
+    let saoh = heuristic == BuildHeuristic::Saoh;
+    match (items.len() == 2, saoh) {
+        (true, true) => best_pair_split::<true>(items, memo, heuristic, centroids, bounds),
+        (true, false) => best_pair_split::<false>(items, memo, heuristic, centroids, bounds),
+        (false, true) => {
+            best_bucket_split::<true>(items, scratch, memo, heuristic, centroids, bounds)
+        }
+        (false, false) => {
+            best_bucket_split::<false>(items, scratch, memo, heuristic, centroids, bounds)
+        }
+    }
+}
+
+fn build_with<E: Emitters + ?Sized>(
+    emitters: &E,
+    heuristic: BuildHeuristic,
+    choose: ChooseSplit,
+) -> Result<LightTree, BuildError> {
     let mut items = validate(emitters)?;
     let n = items.len();
     if n == 0 {
@@ -211,6 +256,7 @@ pub(super) fn build<E: Emitters + ?Sized>(
                 &mut memo,
                 heuristic,
                 t.depth >= median_depth,
+                choose,
             );
         agg.push(Aggregate {
             bounds: Aabb::EMPTY,
@@ -339,6 +385,7 @@ fn split(
     memo: &mut OrientationMemo,
     heuristic: BuildHeuristic,
     force_median: bool,
+    choose: ChooseSplit,
 ) -> usize {
     let (centroids, bounds) = items.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(c, b), it| {
         (c.extend(it.centroid), b.union(&it.bounds))
@@ -347,17 +394,7 @@ fn split(
     if force_median || heuristic == BuildHeuristic::Balanced || extent.max_element() <= 0.0 {
         return median_split(items, centroids.longest_axis());
     }
-    let best = if items.len() == 2 {
-        if heuristic == BuildHeuristic::Saoh {
-            best_pair_split::<true>(items, memo, heuristic, &centroids, &bounds)
-        } else {
-            best_pair_split::<false>(items, memo, heuristic, &centroids, &bounds)
-        }
-    } else if heuristic == BuildHeuristic::Saoh {
-        best_bucket_split::<true>(items, scratch, memo, heuristic, &centroids, &bounds)
-    } else {
-        best_bucket_split::<false>(items, scratch, memo, heuristic, &centroids, &bounds)
-    };
+    let best = choose(items, scratch, memo, heuristic, &centroids, &bounds);
     match best {
         Some((axis, bucket)) if items.len() == 2 => {
             // The pair's buckets differ on `axis`: the lower one goes left.
@@ -744,3 +781,7 @@ fn partition(items: &mut [Item], scratch: &[[u8; 3]], axis: usize, bucket: usize
     }
     mid
 }
+
+#[cfg(test)]
+#[path = "build_reference.rs"]
+mod reference;
