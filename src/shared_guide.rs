@@ -6,6 +6,7 @@
 use crate::field::GuidingField;
 use crate::glt::Glt;
 use crate::light_tree::LightHierarchy;
+use crate::math::Counter;
 use crate::sd_tree::SdTree;
 use crate::spatial::RefineOutcome;
 use std::sync::{RwLock, RwLockReadGuard, TryLockError};
@@ -84,7 +85,9 @@ impl<H: LightHierarchy> Refine for GuidingField<H> {
 #[derive(Debug)]
 pub struct SharedGuide<F> {
     guide: RwLock<F>,
-    refinements: core::sync::atomic::AtomicU64,
+    /// Refinements run; a [`Counter`] works on targets without 64-bit
+    /// atomics too.
+    refinements: Counter,
 }
 
 impl<F: Refine> SharedGuide<F> {
@@ -92,7 +95,7 @@ impl<F: Refine> SharedGuide<F> {
     pub fn new(guide: F) -> Self {
         Self {
             guide: RwLock::new(guide),
-            refinements: core::sync::atomic::AtomicU64::new(0),
+            refinements: Counter::new(),
         }
     }
 
@@ -110,8 +113,7 @@ impl<F: Refine> SharedGuide<F> {
     /// decides).
     pub fn refine(&self) -> RefineOutcome {
         let mut guide = self.guide.write().unwrap_or_else(|e| e.into_inner());
-        self.refinements
-            .fetch_add(1, core::sync::atomic::Ordering::Relaxed);
+        self.refinements.bump();
         guide.refine()
     }
 
@@ -122,14 +124,13 @@ impl<F: Refine> SharedGuide<F> {
             Err(TryLockError::Poisoned(e)) => e.into_inner(),
             Err(TryLockError::WouldBlock) => return None,
         };
-        self.refinements
-            .fetch_add(1, core::sync::atomic::Ordering::Relaxed);
+        self.refinements.bump();
         Some(guide.refine())
     }
 
     /// How many refinements ran.
     pub fn refinements(&self) -> u64 {
-        self.refinements.load(core::sync::atomic::Ordering::Relaxed)
+        self.refinements.get()
     }
 
     /// The guide, for `&mut` access when no thread shares it.
