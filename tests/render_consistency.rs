@@ -1,6 +1,6 @@
 //! The `render` example's integrator gives the same image with every
-//! method: per-method image means (whole image and quadrants) agree within
-//! their statistical error on `box`, on a small many-light scene (`ring`
+//! method: per-method image means (whole image and quadrants) agree with an
+//! independent reference within their statistical error on `box`, on a small many-light scene (`ring`
 //! with 1,536 lights) and on `few-lights` (environment light). And the
 //! `embed` example runs and passes its own checks.
 //!
@@ -80,12 +80,16 @@ fn region_means(r: &Rendered) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Renders `scene` with every method at `spp` and checks that all region
-/// means agree with their inverse-variance weighted average within `k`
-/// standard errors (plus 0.5% for the variance estimates' own noise).
+/// Renders `scene` with every method at `spp` and checks each region mean
+/// against an independent reference: `pt-bvh` (no learning; its sampler is
+/// chi-square tested on its own) at 16x the samples with another seed.
+/// Each method must agree within `k` standard errors of the difference
+/// (plus 0.5% for the variance estimates' own noise). A reference rather
+/// than the methods' pooled mean, so a bias the guided methods share cannot
+/// pull the yardstick with it.
 fn methods_agree(name: &str, width: u32, height: u32, spp: u64) {
     let scene = scenes::build(name, scenes::Size::Small).expect("known scene");
-    let settings = Settings {
+    let mut settings = Settings {
         width,
         height,
         budget: Budget::Spp(spp),
@@ -101,10 +105,14 @@ fn methods_agree(name: &str, width: u32, height: u32, spp: u64) {
             glt_filter: guiding::spatial::SpatialFilter::Nearest,
             prior: CutConfig::default().prior,
         },
-        seed: 3,
+        seed: 1001,
         progress: false,
         guide_files: Default::default(),
     };
+    settings.budget = Budget::Spp(16 * spp);
+    let reference = region_means(&run::render(&scene, Method::PtBvh, &settings));
+    settings.budget = Budget::Spp(spp);
+    settings.seed = 3;
     let results: Vec<(Method, Vec<(f64, f64)>)> = Method::ALL
         .iter()
         .map(|&m| {
@@ -119,24 +127,33 @@ fn methods_agree(name: &str, width: u32, height: u32, spp: u64) {
         })
         .collect();
     let k = 4.5;
-    for region in 0..5 {
-        let (mut num, mut den) = (0.0, 0.0);
-        for (_, rm) in &results {
-            let (m, e) = rm[region];
-            assert!(e > 0.0, "{name}: a method reports no error estimate");
-            num += m / (e * e);
-            den += 1.0 / (e * e);
-        }
-        let pooled = num / den;
-        assert!(pooled > 0.0, "{name}: black image");
+    for (region, &(truth, truth_e)) in reference.iter().enumerate() {
+        assert!(truth > 0.0 && truth_e > 0.0, "{name}: black reference");
         for (method, rm) in &results {
             let (m, e) = rm[region];
-            let tolerance = k * e + 0.005 * pooled;
             assert!(
-                (m - pooled).abs() <= tolerance,
-                "{name} region {region}: {} mean {m:.5} +- {e:.5} vs all methods {pooled:.5} (tolerance {tolerance:.5})",
+                e > 0.0,
+                "{name}: {} reports no error estimate",
                 method.name()
             );
+            let tolerance = k * (e * e + truth_e * truth_e).sqrt() + 0.005 * truth;
+            assert!(
+                (m - truth).abs() <= tolerance,
+                "{name} region {region}: {} mean {m:.5} +- {e:.5} vs reference {truth:.5} +- {truth_e:.5} (tolerance {tolerance:.5})",
+                method.name()
+            );
+            // The control: on the whole image the check has the power to
+            // see a GLT method 6% off (a pmf reported 6% too high
+            // everywhere it matters, say). The unguided uniform and power
+            // samplers are too noisy on ring at this spp to see that much.
+            if region == 0 && method.name().ends_with("glt") {
+                assert!(
+                    (m * 0.94 - truth).abs() > tolerance,
+                    "{name}: {} would pass 6% low (tolerance {:.1}%)",
+                    method.name(),
+                    100.0 * tolerance / truth
+                );
+            }
         }
     }
 }
