@@ -31,10 +31,18 @@ pub struct LightTerm {
     /// Its contributing samples from the evaluation set (`m` samples were
     /// drawn per light; the others contributed nothing).
     pub eval: Vec<NeeSample>,
-    /// Mean of `(g / pdf_light)^2` over an independent held-out set of `m`
-    /// samples: the light's second moment, as a clairvoyant pmf would know
-    /// it without seeing the samples that evaluate it.
+    /// Mean of `(g / pdf_light)^2` over an independent, stratified
+    /// held-out set of samples: the light's second moment, as a
+    /// clairvoyant pmf would know it without seeing the samples that
+    /// evaluate it.
     pub held_out_m2: f64,
+    /// Mean of the *unshadowed* `g / pdf_light` over the evaluation set
+    /// (occluded samples included): the light's contribution without
+    /// visibility, which a resampling target integrates to.
+    pub unshadowed: f64,
+    /// The light's visibility at the point from the held-out set: shadowed
+    /// over unshadowed contribution (1 where it has no unshadowed one).
+    pub held_out_visibility: f64,
 }
 
 /// One BSDF sample of the estimator that found an emitter.
@@ -55,7 +63,8 @@ pub struct BsdfHit {
 pub struct PointTerms {
     /// The point.
     pub at: ShadingPoint,
-    /// Lights with a non-zero contribution in either sample set.
+    /// Lights with a non-zero unshadowed contribution in either sample set
+    /// (or found by a BSDF sample).
     pub lights: Vec<LightTerm>,
     /// BSDF samples that hit an emitter.
     pub bsdf: Vec<BsdfHit>,
@@ -69,17 +78,27 @@ pub struct PointTerms {
 }
 
 /// Draws `m` samples of one light (emitter or unbounded) from `at`; calls
-/// `keep` with each contributing one.
+/// `keep` with each one that would contribute without occluders, and
+/// whether it is visible. With `stratified`, and `m` a square, the sample
+/// numbers are jittered in a `sqrt(m) x sqrt(m)` grid.
 fn light_samples(
     scene: &Scene,
     at: &ShadingPoint,
     light: LightId,
-    m: usize,
+    (m, stratified): (usize, bool),
     s: &mut Sampler,
-    mut keep: impl FnMut(NeeSample),
+    mut keep: impl FnMut(NeeSample, bool),
 ) {
-    for _ in 0..m {
-        let u = s.next2();
+    let side = (m as f64).sqrt().round() as usize;
+    let grid = stratified && side * side == m;
+    for i in 0..m {
+        let u = if grid {
+            let j = s.next2();
+            let cell = glam::Vec2::new((i % side) as f32, (i / side) as f32);
+            ((cell + j) / side as f32).min(glam::Vec2::splat(1.0 - f32::EPSILON / 2.0))
+        } else {
+            s.next2()
+        };
         let (point, target, delta) = match light {
             LightId::Emitter(e) => (scene.lights[e as usize].sample(at.p, u), e, false),
             LightId::Unbounded(i) => {
@@ -97,21 +116,28 @@ fn light_samples(
             continue;
         }
         let o = offset_origin(at.p, at.n, lp.wi);
-        if scene.occluded(o, lp.wi, lp.dist, target) {
-            continue;
-        }
-        keep(NeeSample {
-            g,
-            pdf_light: f64::from(lp.pdf),
-            // No BSDF sample competes with a delta light.
-            pdf_bsdf: if delta { 0.0 } else { f64::from(pdf_bsdf) },
-        });
+        let visible = !scene.occluded(o, lp.wi, lp.dist, target);
+        keep(
+            NeeSample {
+                g,
+                pdf_light: f64::from(lp.pdf),
+                // No BSDF sample competes with a delta light.
+                pdf_bsdf: if delta { 0.0 } else { f64::from(pdf_bsdf) },
+            },
+            visible,
+        );
     }
 }
 
-/// Brute force at one point: `m` evaluation and `m` held-out samples of
-/// every light, `k` BSDF samples.
-pub fn measure(scene: &Scene, at: ShadingPoint, m: usize, k: usize, seed: u64) -> PointTerms {
+/// Brute force at one point: `m` evaluation samples and `held` stratified
+/// held-out samples of every light, `k` BSDF samples.
+pub fn measure(
+    scene: &Scene,
+    at: ShadingPoint,
+    (m, held): (usize, usize),
+    k: usize,
+    seed: u64,
+) -> PointTerms {
     let mut s = Sampler::new(seed, 0xb7u64, 1);
     let mut lights = Vec::new();
     let mut direct = 0.0;
@@ -120,19 +146,31 @@ pub fn measure(scene: &Scene, at: ShadingPoint, m: usize, k: usize, seed: u64) -
         .chain((0..scene.unbounded.len() as u32).map(LightId::Unbounded));
     for light in ids {
         let mut eval = Vec::new();
-        light_samples(scene, &at, light, m, &mut s, |x| eval.push(x));
-        let mut held = 0.0;
-        light_samples(scene, &at, light, m, &mut s, |x| {
-            held += (x.g / x.pdf_light).powi(2);
+        let mut unshadowed = 0.0;
+        light_samples(scene, &at, light, (m, false), &mut s, |x, visible| {
+            unshadowed += x.g / x.pdf_light;
+            if visible {
+                eval.push(x);
+            }
         });
-        if eval.is_empty() && held == 0.0 {
+        let (mut m2, mut seen, mut all) = (0.0, 0.0, 0.0);
+        light_samples(scene, &at, light, (held, true), &mut s, |x, visible| {
+            all += x.g / x.pdf_light;
+            if visible {
+                m2 += (x.g / x.pdf_light).powi(2);
+                seen += x.g / x.pdf_light;
+            }
+        });
+        if unshadowed == 0.0 && all == 0.0 {
             continue;
         }
         direct += eval.iter().map(|x| x.g / x.pdf_light).sum::<f64>() / m as f64;
         lights.push(LightTerm {
             light,
             eval,
-            held_out_m2: held / m as f64,
+            held_out_m2: m2 / held.max(1) as f64,
+            unshadowed: unshadowed / m as f64,
+            held_out_visibility: if all > 0.0 { seen / all } else { 1.0 },
         });
     }
     let mut index: HashMap<LightId, usize> = lights
@@ -181,6 +219,8 @@ pub fn measure(scene: &Scene, at: ShadingPoint, m: usize, k: usize, seed: u64) -
                 light,
                 eval: Vec::new(),
                 held_out_m2: 0.0,
+                unshadowed: 0.0,
+                held_out_visibility: 1.0,
             });
             lights.len() - 1
         });

@@ -84,10 +84,26 @@ struct Args {
     /// hit).
     #[arg(long, default_value_t = 1)]
     vertex: u32,
-    /// Light samples per light in each of the two sets (evaluation,
-    /// held-out).
+    /// Light samples per light in the evaluation set (the domain of the
+    /// variances, the same for every pmf).
     #[arg(long, default_value_t = 4)]
     light_samples: usize,
+    /// Stratified light samples per light in the held-out set the
+    /// clairvoyant pmf is computed from (on city it converges from about
+    /// 16; 4 under-reads its variance ratio by ~2x).
+    #[arg(long, default_value_t = 16)]
+    held_out_samples: usize,
+    /// Also report every pmf's variance with the BSDF part estimated from
+    /// the BSDF samples themselves (the instrument before the light-domain
+    /// integration), to show the difference.
+    #[arg(long)]
+    bsdf_sampled: bool,
+    /// Candidate counts for resampled next-event estimation from each GLT
+    /// variant's pmf (comma separated; `variance::resampled_parts`), each
+    /// measured with a visibility-blind target and with the held-out
+    /// visibility at the point (the best a learned visibility could do).
+    #[arg(long, value_delimiter = ',')]
+    resample: Vec<usize>,
     /// BSDF samples per point.
     #[arg(long, default_value_t = 64)]
     bsdf_samples: usize,
@@ -171,20 +187,24 @@ fn run(args: &Args) -> Result<(), String> {
     Ok(())
 }
 
-/// The pmf of every contributing light at every point under `sampler`.
+/// The variance at every point under `pmf`: with the BSDF part integrated
+/// in the light-sample domain, and with it estimated from the BSDF samples
+/// (the instrument before).
 fn pmfs_of(
     points: &[PointTerms],
     pmf: impl Fn(&ShadingContext, LightId) -> f64 + Sync,
-) -> Vec<f64> {
-    let v: Vec<f64> = points
+) -> (Vec<f64>, Vec<f64>) {
+    points
         .par_iter()
         .map(|t| {
             let ctx = ShadingContext::on_surface(t.at.p, t.at.n);
             let pmfs: Vec<f64> = t.lights.iter().map(|l| pmf(&ctx, l.light)).collect();
-            variance::variance(t, &pmfs)
+            (
+                variance::variance(t, &pmfs),
+                variance::variance_bsdf_sampled(t, &pmfs),
+            )
         })
-        .collect();
-    v
+        .unzip()
 }
 
 fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec<Record>, String> {
@@ -209,7 +229,7 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
             brute_force::measure(
                 &scene,
                 p,
-                args.light_samples,
+                (args.light_samples, args.held_out_samples),
                 args.bsdf_samples,
                 rng::mix64(args.seed ^ i as u64),
             )
@@ -238,8 +258,11 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
         ("bvh", Method::PtBvh),
     ] {
         let sampler = methods::fixed_sampler(&scene, method).ok_or("a fixed sampler")?;
-        let v = pmfs_of(&points, |ctx, l| f64::from(sampler.pmf(ctx, l)));
+        let (v, vb) = pmfs_of(&points, |ctx, l| f64::from(sampler.pmf(ctx, l)));
         records.push(record(label, &v, 0, 0));
+        if args.bsdf_sampled {
+            records.push(record(&format!("{label} [bsdf-sampled]"), &vb, 0, 0));
+        }
     }
     for variant in variants {
         let t = Instant::now();
@@ -254,7 +277,7 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
         };
         let (_, trained) = run::render_trained(&scene, Method::PtGlt, &settings);
         let glt = trained.glt.ok_or("pt-glt trains a GLT")?;
-        let v = pmfs_of(&points, |ctx, l| f64::from(glt.pmf(ctx, l)));
+        let (v, vb) = pmfs_of(&points, |ctx, l| f64::from(glt.pmf(ctx, l)));
         if args.breakdown {
             let pmf_vectors =
                 |f: &(dyn Fn(&ShadingContext, LightId) -> f64 + Sync)| -> Vec<Vec<f64>> {
@@ -284,6 +307,31 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
             glt.memory().total(),
             variant.train_spp,
         ));
+        if args.bsdf_sampled {
+            let name = format!("{} [bsdf-sampled]", variant.name);
+            records.push(record(&name, &vb, 0, variant.train_spp));
+        }
+        for &m in &args.resample {
+            for oracle in [false, true] {
+                let v: Vec<f64> = points
+                    .par_iter()
+                    .map(|t| {
+                        let ctx = ShadingContext::on_surface(t.at.p, t.at.n);
+                        let pmfs: Vec<f64> = t
+                            .lights
+                            .iter()
+                            .map(|l| f64::from(glt.pmf(&ctx, l.light)))
+                            .collect();
+                        let vis = variance::visibilities(t, oracle, 0.05);
+                        let (nee, bsdf) = variance::resampled_parts(t, &pmfs, &vis, m);
+                        nee + bsdf
+                    })
+                    .collect();
+                let target = if oracle { "x visibility" } else { "unshadowed" };
+                let name = format!("{} resampled M={m} ({target})", variant.name);
+                records.push(record(&name, &v, 0, variant.train_spp));
+            }
+        }
         println!(
             "  {}: trained {} spp in {:.1} s",
             variant.name,
@@ -291,20 +339,36 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
             t.elapsed().as_secs_f64()
         );
     }
-    let v: Vec<f64> = points
+    let (v, vb): (Vec<f64>, Vec<f64>) = points
         .par_iter()
-        .map(|t| variance::variance(t, &variance::clairvoyant(t)))
-        .collect();
+        .map(|t| {
+            let c = variance::clairvoyant(t);
+            (
+                variance::variance(t, &c),
+                variance::variance_bsdf_sampled(t, &c),
+            )
+        })
+        .unzip();
     records.push(record("clairvoyant", &v, 0, 0));
+    if args.bsdf_sampled {
+        records.push(record("clairvoyant [bsdf-sampled]", &vb, 0, 0));
+    }
     Ok(records)
 }
 
 /// The printed table of one scene.
 fn table(records: &[Record]) -> String {
-    let clair = records
-        .iter()
-        .find(|r| r.method == "clairvoyant")
-        .map_or(f64::NAN, |r| r.rel_variance);
+    let clair_of = |method: &str| {
+        let name = if method.ends_with("[bsdf-sampled]") {
+            "clairvoyant [bsdf-sampled]"
+        } else {
+            "clairvoyant"
+        };
+        records
+            .iter()
+            .find(|r| r.method == name)
+            .map_or(f64::NAN, |r| r.rel_variance)
+    };
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -318,7 +382,7 @@ fn table(records: &[Record]) -> String {
             r.scene,
             r.method,
             r.rel_variance,
-            r.rel_variance / clair,
+            r.rel_variance / clair_of(&r.method),
             r.glt_bytes as f64 / 1e6
         );
     }
