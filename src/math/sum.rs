@@ -388,6 +388,65 @@ mod tests {
     }
 
     #[test]
+    fn sizes() {
+        let fast = if cfg!(target_has_atomic = "64") {
+            8
+        } else {
+            48
+        };
+        for (mode, per_sum) in [
+            (Accumulation::Fast, fast),
+            (Accumulation::Deterministic, 48),
+        ] {
+            let s = SumBuffer::new(3, mode);
+            assert!(!s.is_empty());
+            assert_eq!(s.len(), 3);
+            assert_eq!(s.bytes_per_sum(), per_sum);
+            assert_eq!(s.bytes(), 3 * per_sum);
+            assert!(SumBuffer::new(0, mode).is_empty());
+        }
+    }
+
+    #[test]
+    fn merge_adds_and_refuses_mismatches() {
+        for mode in [Accumulation::Fast, Accumulation::Deterministic] {
+            let mut a = SumBuffer::new(2, mode);
+            let b = SumBuffer::new(2, mode);
+            a.add(0, 1.5);
+            a.add(1, 2.0);
+            b.add(0, 0.25);
+            b.add(1, 4.0);
+            assert!(a.merge(&b));
+            assert_eq!((a.get(0), a.get(1)), (1.75, 6.0), "{mode:?}");
+            // Merging twice adds twice; the other side is unchanged.
+            assert!(a.merge(&b));
+            assert_eq!((a.get(0), a.get(1)), (2.0, 10.0), "{mode:?}");
+            assert_eq!((b.get(0), b.get(1)), (0.25, 4.0));
+            // Another length or another mode: refused, nothing changed.
+            let longer = SumBuffer::new(3, mode);
+            assert!(!a.merge(&longer));
+            let other = match mode {
+                Accumulation::Fast => Accumulation::Deterministic,
+                Accumulation::Deterministic => Accumulation::Fast,
+            };
+            let c = SumBuffer::new(2, other);
+            if c.mode() != a.mode() {
+                c.add(0, 100.0);
+                assert!(!a.merge(&c));
+            }
+            assert_eq!((a.get(0), a.get(1)), (2.0, 10.0));
+        }
+        // As many words, another mode (6 fast sums, 1 exact one on 64-bit
+        // words): refused too.
+        if cfg!(target_has_atomic = "64") {
+            let mut fast = SumBuffer::new(EXACT_WORDS, Accumulation::Fast);
+            let exact = SumBuffer::new(1, Accumulation::Deterministic);
+            assert_eq!(fast.words.len(), exact.words.len());
+            assert!(!fast.merge(&exact));
+        }
+    }
+
+    #[test]
     fn clear_and_reset() {
         let mut s = SumBuffer::new(3, Accumulation::Deterministic);
         s.add(2, 5.0);
