@@ -32,6 +32,7 @@
 //! | what | file |
 //! | --- | --- |
 //! | the GLT's sampling rule and pmf | `src/glt/sampling.rs` |
+//! | resampled light choice (candidates, reservoir, weight) | `src/resampling.rs` |
 //! | the light tree laid out for the GLT's walk | `src/glt/walk.rs` |
 //! | cut refinement (split / merge by sigma, `min_splats`) | `src/glt/refine.rs` |
 //! | the tables every cut reads (`CutRules`) | `src/glt/cut_rules.rs` |
@@ -78,6 +79,7 @@ pub mod mis;
 pub mod path_recorder;
 pub mod persist;
 pub mod quadtree;
+pub mod resampling;
 pub mod schedule;
 pub mod sd_tree;
 #[cfg(feature = "std")]

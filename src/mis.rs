@@ -136,6 +136,34 @@ impl Convention {
     }
 }
 
+/// The light sample of a resampled light choice
+/// ([`crate::resampling::resample`]) under pbrt-v4's convention: the MIS
+/// weight against the BSDF sample takes the candidate density
+/// `pmf * pdf_light` as the light strategy's (proxy) density, as the BSDF
+/// sample's weight [`Convention::bsdf_sample`] does with the pmf of the
+/// light it hit, so the two weights sum to one and the combination is
+/// unbiased; the factor is `weight_mis * weight / pdf_light` (`weight` the
+/// resampled choice's, in place of `1 / pmf`). A delta light: `pdf_light`
+/// 1 and `pdf_bsdf` 0.
+///
+/// pbrt-v3's convention is not offered: its BSDF sample counts only for the
+/// chosen light, weighed by the same `1 / pmf`, which resampling keeps
+/// unbiased only where the renderer's unshadowed estimate is positive
+/// everywhere a light's own sampling can land.
+#[inline]
+pub fn resampled_light_sample(pmf: f32, weight: f32, pdf_light: f32, pdf_bsdf: f32) -> DirectLight {
+    let w = power_heuristic(pmf * pdf_light, pdf_bsdf);
+    let f = f64::from(w) * f64::from(weight) / f64::from(pdf_light);
+    if f > 0.0 && f.is_finite() && pmf > 0.0 && pmf.is_finite() {
+        DirectLight {
+            weight: w,
+            factor: f as f32,
+        }
+    } else {
+        DirectLight::NONE
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
