@@ -447,6 +447,57 @@ mod tests {
     }
 
     #[test]
+    fn saved_sums_round_trip_and_hostile_ones_are_refused() {
+        use crate::persist::{Kind, LoadError, Reader, Writer};
+        let sealed = |write: &dyn Fn(&mut Writer)| {
+            let mut w = Writer::default();
+            write(&mut w);
+            w.finish(Kind::Glt)
+        };
+        let read = |bytes: &[u8], mode, n| {
+            let mut r = Reader::open(bytes, Kind::Glt).unwrap();
+            SumBuffer::read(&mut r, "sums", mode, n)
+        };
+        for mode in [Accumulation::Fast, Accumulation::Deterministic] {
+            let s = SumBuffer::new(3, mode);
+            s.add(0, 1.5);
+            s.add(2, 1e30);
+            let back = read(&sealed(&|w| s.write(w)), mode, 3).unwrap();
+            assert_eq!(
+                [back.get(0), back.get(1), back.get(2)],
+                [s.get(0), 0.0, s.get(2)]
+            );
+            // Another count than expected, or the other mode: refused.
+            assert!(read(&sealed(&|w| s.write(w)), mode, 2).is_err());
+        }
+        if cfg!(target_has_atomic = "64") {
+            // Fast sums must be finite and non-negative.
+            for bad in [-1.0, f64::INFINITY, f64::NAN] {
+                let bytes = sealed(&|w| {
+                    w.bool(false);
+                    w.len(2);
+                    w.f64(1.0);
+                    w.f64(bad);
+                });
+                let r = read(&bytes, Accumulation::Fast, 2);
+                assert!(matches!(r, Err(LoadError::Invalid { .. })), "{bad}: {r:?}");
+            }
+        }
+        // An exact count that the bytes left cannot hold at 48 bytes a sum
+        // is refused at the count, before anything is allocated.
+        let bytes = sealed(&|w| {
+            w.bool(true);
+            w.len(40);
+            w.bytes(&[0u8; 48]);
+        });
+        let r = read(&bytes, Accumulation::Deterministic, 40);
+        assert!(
+            matches!(r, Err(LoadError::Truncated { offset, .. }) if offset == 38 + 1),
+            "{r:?}"
+        );
+    }
+
+    #[test]
     fn clear_and_reset() {
         let mut s = SumBuffer::new(3, Accumulation::Deterministic);
         s.add(2, 5.0);
