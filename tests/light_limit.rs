@@ -135,6 +135,7 @@ fn resampled_variance_matches_a_simulation() {
             held_out_m2: 0.0,
             unshadowed: pts.iter().map(|x| x.0 / x.1).sum::<f64>() / K as f64,
             held_out_visibility: 1.0,
+            held_out_unshadowed_m2: 0.0,
         })
         .collect();
     let t = PointTerms {

@@ -43,6 +43,8 @@ pub struct LightTerm {
     /// The light's visibility at the point from the held-out set: shadowed
     /// over unshadowed contribution (1 where it has no unshadowed one).
     pub held_out_visibility: f64,
+    /// Mean of the unshadowed `(g / pdf_light)^2` over the held-out set.
+    pub held_out_unshadowed_m2: f64,
 }
 
 /// One BSDF sample of the estimator that found an emitter.
@@ -153,9 +155,10 @@ pub fn measure(
                 eval.push(x);
             }
         });
-        let (mut m2, mut seen, mut all) = (0.0, 0.0, 0.0);
+        let (mut m2, mut seen, mut all, mut m2u) = (0.0, 0.0, 0.0, 0.0);
         light_samples(scene, &at, light, (held, true), &mut s, |x, visible| {
             all += x.g / x.pdf_light;
+            m2u += (x.g / x.pdf_light).powi(2);
             if visible {
                 m2 += (x.g / x.pdf_light).powi(2);
                 seen += x.g / x.pdf_light;
@@ -171,6 +174,7 @@ pub fn measure(
             held_out_m2: m2 / held.max(1) as f64,
             unshadowed: unshadowed / m as f64,
             held_out_visibility: if all > 0.0 { seen / all } else { 1.0 },
+            held_out_unshadowed_m2: m2u / held.max(1) as f64,
         });
     }
     let mut index: HashMap<LightId, usize> = lights
@@ -221,6 +225,7 @@ pub fn measure(
                 held_out_m2: 0.0,
                 unshadowed: 0.0,
                 held_out_visibility: 1.0,
+                held_out_unshadowed_m2: 0.0,
             });
             lights.len() - 1
         });

@@ -332,11 +332,26 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
                 records.push(record(&name, &v, 0, variant.train_spp));
             }
         }
+        // How much of the variance is the BSDF sample's (which a better
+        // light choice alone cannot remove), in the relMSE normalisation.
+        let bsdf_only: Vec<f64> = points
+            .par_iter()
+            .map(|t| {
+                let ctx = ShadingContext::on_surface(t.at.p, t.at.n);
+                let pmfs: Vec<f64> = t
+                    .lights
+                    .iter()
+                    .map(|l| f64::from(glt.pmf(&ctx, l.light)))
+                    .collect();
+                variance::parts(t, &pmfs).1
+            })
+            .collect();
         println!(
-            "  {}: trained {} spp in {:.1} s",
+            "  {}: trained {} spp in {:.1} s; the BSDF sample's part of its variance: {:.1}%",
             variant.name,
             variant.train_spp,
-            t.elapsed().as_secs_f64()
+            t.elapsed().as_secs_f64(),
+            100.0 * variance::relative(&points, &bsdf_only) / variance::relative(&points, &v)
         );
     }
     let (v, vb): (Vec<f64>, Vec<f64>) = points
