@@ -11,8 +11,9 @@
 //!
 //! With candidates `x_j = (l_j, y_j)` drawn with density `q = P(l) p_l(y)`
 //! and the renderer's unshadowed estimate `c_j = f cos Le / p_l` at `y_j`,
-//! the candidate weights are `w_j = c_j t_j / P(l_j)` (`t_j` an optional
-//! per-candidate factor, e.g. a learned visibility), one candidate `s` is
+//! the candidate weights are `w_j = c_j t_j / P(l_j)` (`t_j` the
+//! renderer's factor, if any, times what the sampler learned of the
+//! light's visibility, [`LightSampler::visibility`]), one candidate `s` is
 //! kept with probability `w_s / sum w`, and
 //!
 //! ```text
@@ -76,9 +77,9 @@ pub struct Evaluated<T> {
     /// fixed scalar of the spectrum). 0 (or negative, NaN) when it cannot
     /// contribute: it is then never kept.
     pub contribution: f32,
-    /// A factor on the target, in `(0, inf)`: 1 for plain resampling, a
-    /// learned visibility to favour lights that are seen. Values that are
-    /// not finite and positive count as 1.
+    /// The renderer's own factor on the target, in `(0, inf)`; 1 for none
+    /// (the sampler's learned visibility is applied on top). Values that
+    /// are not finite and positive count as 1.
     pub factor: f32,
     /// Kept with the candidate if it is chosen.
     pub payload: T,
@@ -101,7 +102,8 @@ impl<T> Evaluated<T> {
 /// candidates[j])`, `evaluate(light, j)` says what it contributes without
 /// visibility (the renderer samples a point on the light; `None` counts as
 /// no contribution), and `u` keeps one in proportion to `contribution *
-/// factor / pmf` (see the module docs for the weight). `None` when no
+/// factor * sampler.visibility(ctx, light) / pmf` (see the module docs for
+/// the weight). `None` when no
 /// candidate contributes (then neither would the light sample: the
 /// estimate is 0) or `candidates` is empty.
 ///
@@ -131,12 +133,11 @@ where
         if !(c > 0.0 && c.is_finite()) {
             continue;
         }
-        let factor = f64::from(e.factor);
-        let factor = if factor > 0.0 && factor.is_finite() {
-            factor
-        } else {
-            1.0
+        let valid = |x: f32| {
+            let x = f64::from(x);
+            if x > 0.0 && x.is_finite() { x } else { 1.0 }
         };
+        let factor = valid(e.factor) * valid(sampler.visibility(ctx, x.light));
         let target = c * factor;
         let w = target / f64::from(x.pmf);
         if !(w > 0.0 && w.is_finite()) {

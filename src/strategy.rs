@@ -133,4 +133,8 @@ impl LightSampler for Strategy {
     fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
         inner!(self, s => s.pmf_exact(ctx, light))
     }
+
+    fn visibility(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        inner!(self, s => s.visibility(ctx, light))
+    }
 }

@@ -265,6 +265,7 @@ fn config_strategy() -> impl Strategy<Value = CutConfig> {
                     } else {
                         Prior::Power
                     },
+                    visibility: modulate != exact,
                 }
             },
         )

@@ -23,6 +23,8 @@ struct Sample {
     p: Vec3,
     light: u32,
     light_value: f32,
+    /// What the light's record would have been without the wall.
+    unshadowed: f32,
     dir: Vec3,
     radiance: f32,
     jitter: [f32; 3],
@@ -36,10 +38,13 @@ fn samples(seed: u64, n: usize) -> Vec<Sample> {
             let p = rng.point(9.5);
             let light = rng.below(80);
             let dir = rng.dir();
+            let f = rng.range(0.5, 2.0);
+            let c = lights[light as usize].bounds.center();
             Sample {
                 p,
                 light,
-                light_value: value(&lights, light, p) * rng.range(0.5, 2.0),
+                light_value: value(&lights, light, p) * f,
+                unshadowed: lights[light as usize].power / (c - p).length_squared().max(1.0) * f,
                 dir,
                 radiance: 1.0 + 30.0 * dir.y.max(0.0).powi(6),
                 jitter: [rng.f(), rng.f(), rng.f()],
@@ -61,6 +66,7 @@ trait Farmable: Sized {
 impl Farmable for Glt<&'static LightTree> {
     fn record(&self, s: &Sample) {
         self.splat_at(s.p, LightId::Emitter(s.light), s.light_value);
+        self.splat_visibility(s.p, LightId::Emitter(s.light), s.light_value, s.unshadowed);
     }
     fn clear(&mut self) {
         self.clear_records();
@@ -110,6 +116,7 @@ impl Farmable for GuidingField<&'static LightTree> {
             s.light_value,
             &mut JitterNumbers(s.jitter),
         );
+        v.splat_visibility(LightId::Emitter(s.light), s.light_value, s.unshadowed);
         v.splat_radiance(s.dir, s.radiance, 0.4, &mut JitterNumbers(s.jitter));
     }
     fn clear(&mut self) {
@@ -206,6 +213,7 @@ fn glt_workers_merge_bit_for_bit() {
             // Many cuts stay below the floor and carry their sums into the
             // next iteration: a share must not carry them again.
             min_splats: 300,
+            visibility: true,
             ..CutConfig::default()
         },
         spatial_threshold: 400.0,
@@ -231,6 +239,7 @@ fn field_workers_merge_bit_for_bit() {
     config.sd.accumulation = Accumulation::Deterministic;
     config.sd.spatial_threshold = 400.0;
     config.cut.accumulation = Accumulation::Deterministic;
+    config.cut.visibility = true;
     check_farm(GuidingField::new(tree(), scene(), config).unwrap());
 }
 

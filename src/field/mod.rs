@@ -294,4 +294,10 @@ impl<H: LightHierarchy> LightSampler for GuidingField<H> {
         self.cell_at(ctx.position)
             .map_or(0.0, |cell| self.guide.pmf_exact(&cell.cut, ctx, light))
     }
+
+    /// The learned visibility of `light` in the cell of `ctx.position`.
+    fn visibility(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        self.cell_at(ctx.position)
+            .map_or(1.0, |cell| self.guide.visibility(&cell.cut, light))
+    }
 }

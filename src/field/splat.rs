@@ -80,6 +80,28 @@ impl<H: LightHierarchy> GuidingField<H> {
         )
     }
 
+    /// [`Glt::splat_visibility`](crate::glt::Glt::splat_visibility) for
+    /// the cell holding `p`: what a next-event sample saw, for the learned
+    /// visibility. Bad input is dropped and counted.
+    pub fn splat_visibility(
+        &self,
+        p: Vec3,
+        light: LightId,
+        shadowed: f32,
+        unshadowed: f32,
+    ) -> SplatOutcome {
+        let outcome = match self.cell_at(p) {
+            Some(cell) => self
+                .guide
+                .splat_visibility(&cell.cut, light, shadowed, unshadowed),
+            None => SplatOutcome::Dropped,
+        };
+        if outcome == SplatOutcome::Dropped {
+            self.sd.dropped.count(crate::dropped::DropReason::Light);
+        }
+        outcome
+    }
+
     /// Reports one direction sample to the BSDF-fraction learner of the
     /// cell at `p`, exactly as
     /// [`SdTree::record_fraction`](crate::sd_tree::SdTree::record_fraction).

@@ -133,6 +133,22 @@ impl<'f, H: LightHierarchy> FieldVertex<'f, H> {
             .record_light((self.p, Some(self.at)), light, value, filter)
     }
 
+    /// [`GuidingField::splat_visibility`] at this vertex's cell.
+    #[inline]
+    pub fn splat_visibility(&self, light: LightId, shadowed: f32, unshadowed: f32) -> SplatOutcome {
+        let outcome =
+            self.field
+                .guide
+                .splat_visibility(&self.cell.cut, light, shadowed, unshadowed);
+        if outcome == SplatOutcome::Dropped {
+            self.field
+                .sd
+                .dropped
+                .count(crate::dropped::DropReason::Light);
+        }
+        outcome
+    }
+
     /// [`GuidingField::record_fraction`] at this vertex's cell.
     #[inline]
     pub fn record_fraction(&self, bsdf_pdf: f32, guiding_pdf: f32, contribution: f32) -> bool {
@@ -166,5 +182,10 @@ impl<H: LightHierarchy> LightSampler for FieldVertex<'_, H> {
     #[inline]
     fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
         self.field.guide.pmf_exact(&self.cell.cut, ctx, light)
+    }
+
+    /// The learned visibility of `light` in the located cell.
+    fn visibility(&self, _ctx: &ShadingContext, light: LightId) -> f32 {
+        self.field.guide.visibility(&self.cell.cut, light)
     }
 }

@@ -158,6 +158,17 @@ pub struct CutConfig {
     /// `0` gives the paper's rule (rebuild from any data). Default 64,
     /// measured (docs/results.md, "The cut's data floor").
     pub min_splats: u32,
+    /// Learn each cut cluster's visibility: the fraction of its unshadowed
+    /// contribution that arrives, from next-event records that carry both
+    /// (`splat_visibility` of [`crate::glt::Glt`], its vertex, the field and
+    /// [`CutRules::splat_visibility`](super::CutRules::splat_visibility)),
+    /// shrunk towards what the cluster had before when it has few records
+    /// and never below 1/64. It is the factor resampled light choice puts
+    /// on its target ([`crate::LightSampler::visibility`],
+    /// [`crate::resampling`]); sampling by the cut itself does not read
+    /// it. Costs 20 bytes per cut slot (the value and two sums; 100 with
+    /// [`Accumulation::Deterministic`]). Default false.
+    pub visibility: bool,
 }
 
 impl Default for CutConfig {
@@ -172,6 +183,7 @@ impl Default for CutConfig {
             unbounded: UnboundedLights::NONE,
             accumulation: Accumulation::Fast,
             min_splats: 64,
+            visibility: false,
         }
     }
 }

@@ -47,6 +47,16 @@ pub struct GuidingCut {
     /// sampling modulates them by the importance at the shading point;
     /// else they are plain learned probabilities.
     pub(super) modulated: bool,
+    /// The learned visibility of each slot, then of each unbounded light
+    /// (indexed as the sums), in `[1/64, 1]`; empty unless
+    /// [`CutConfig::visibility`](super::CutConfig::visibility).
+    pub(super) visibility: Box<[f32]>,
+    /// Per slot and unbounded light, the shadowed and the unshadowed
+    /// values of the next-event records since the last rebuild (sums
+    /// `2 i` and `2 i + 1`); empty unless visibility is learned.
+    pub(super) seen: SumBuffer,
+    /// Visibility records since the last rebuild.
+    pub(super) seen_records: Counter,
 }
 
 /// Why [`GuidingCut::check`] rejected a cut.
@@ -143,6 +153,7 @@ impl GuidingCut {
         };
         let k = config.unbounded.count;
         let sums = SumBuffer::new(sum_count(nodes.len(), k), config.accumulation);
+        let nodes_len = nodes.len();
         Self {
             nodes,
             sums,
@@ -151,6 +162,9 @@ impl GuidingCut {
             recorded: Counter::new(),
             anchor: SumBuffer::new(anchor_sums(config), config.accumulation),
             modulated,
+            visibility: vec![1.0; visibility_slots(nodes_len, config)].into_boxed_slice(),
+            seen: SumBuffer::new(2 * visibility_slots(nodes_len, config), config.accumulation),
+            seen_records: Counter::new(),
         }
     }
 
@@ -266,8 +280,9 @@ impl GuidingCut {
     pub fn memory(&self) -> CutMemory {
         CutMemory {
             nodes: self.nodes.len(),
-            node_bytes: self.nodes.len() * CutNode::BYTES + self.unbounded.len() * 4,
-            sum_bytes: self.sums.bytes() + self.anchor.bytes(),
+            node_bytes: self.nodes.len() * CutNode::BYTES
+                + (self.unbounded.len() + self.visibility.len()) * 4,
+            sum_bytes: self.sums.bytes() + self.anchor.bytes() + self.seen.bytes(),
             inline_bytes: core::mem::size_of::<Self>(),
         }
     }
@@ -278,7 +293,15 @@ impl GuidingCut {
         self.nodes.len() * CutNode::BYTES
             + self.sums.bytes()
             + self.anchor.bytes()
-            + self.unbounded.len() * 4
+            + self.seen.bytes()
+            + (self.unbounded.len() + self.visibility.len()) * 4
+    }
+
+    /// The learned visibility of each slot, then of each unbounded light,
+    /// in the order of the sums (see the type's docs); empty unless
+    /// [`CutConfig::visibility`](super::CutConfig::visibility).
+    pub fn visibility(&self) -> &[f32] {
+        &self.visibility
     }
 
     /// Adds the position `p` a splat came from, with `weight` (its share
@@ -333,6 +356,20 @@ pub(super) fn anchor_sums(config: &CutConfig) -> usize {
     match config.modulation {
         super::Modulation::None => 0,
         super::Modulation::Importance => 7,
+    }
+}
+
+/// The smallest learned visibility: learning alone never takes a cluster's
+/// resampling target to 0.
+pub(crate) const MIN_VISIBILITY: f32 = 1.0 / 64.0;
+
+/// Learned visibilities for a cut of `nodes` nodes: one per sum when
+/// visibility is learned, none otherwise.
+pub(super) fn visibility_slots(nodes: usize, config: &CutConfig) -> usize {
+    if config.visibility {
+        sum_count(nodes, config.unbounded.count)
+    } else {
+        0
     }
 }
 

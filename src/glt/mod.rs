@@ -16,6 +16,9 @@
 //!   children of a node in one 16-byte load);
 //! - `splat.rs`: recording direct-light estimates ([`CutRules::splat`]);
 //! - `refine.rs`: rebuilding the cut from its sums ([`CutRules::refine`]);
+//! - `visibility.rs`: each cluster's learned visibility
+//!   ([`CutRules::splat_visibility`], [`CutConfig::visibility`]), the
+//!   target factor of resampled light choice;
 //! - `config.rs`: [`CutConfig`], [`BelowCut`], [`SplitPrior`];
 //! - `standalone.rs`: [`Glt`], one cut per cell of its own spatial tree, a
 //!   [`crate::LightSampler`].
@@ -44,6 +47,7 @@ mod refine;
 mod sampling;
 mod splat;
 mod standalone;
+mod visibility;
 mod walk;
 
 pub use config::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};

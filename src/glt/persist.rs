@@ -3,7 +3,7 @@
 //! layout); merging two GLTs' statistics.
 
 use super::config::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
-use super::cut::{GuidingCut, anchor_sums, sum_count};
+use super::cut::{GuidingCut, MIN_VISIBILITY, anchor_sums, sum_count, visibility_slots};
 use super::cut_node::CutNode;
 use super::cut_rules::CutRules;
 use super::standalone::{Glt, GltCell, GltConfig};
@@ -38,6 +38,7 @@ impl CutConfig {
         w.f64(self.unbounded.probability);
         w.u8(tag(&ACCUMULATION, self.accumulation));
         w.u32(self.min_splats);
+        w.bool(self.visibility);
     }
 
     pub(crate) fn read(r: &mut Reader<'_>) -> Result<Self, LoadError> {
@@ -67,6 +68,8 @@ impl CutConfig {
             },
             accumulation: untag(r, "cut config: accumulation", &ACCUMULATION)?,
             min_splats: r.u32("cut config: min_splats")?,
+            // Version 1 had no learned visibility.
+            visibility: r.version() >= 2 && r.bool("cut config: visibility")?,
         };
         config.validate().map_err(|e| config_error(e, at))?;
         Ok(config)
@@ -116,6 +119,15 @@ impl GuidingCut {
         w.u64(self.recorded.get());
         self.anchor.write(w);
         w.bool(self.modulated);
+        // Version 2: the learned visibility, when the configuration learns
+        // it (its length is the sums').
+        if !self.visibility.is_empty() {
+            for &v in self.visibility.iter() {
+                w.f32(v);
+            }
+            self.seen.write(w);
+            w.u64(self.seen_records.get());
+        }
     }
 
     /// Reads a cut of `rules`' light tree and configuration, checked
@@ -150,6 +162,19 @@ impl GuidingCut {
         let recorded = Counter::with(r.u64("cut: recorded")?);
         let anchor = SumBuffer::read(r, "cut: anchor", config.accumulation, anchor_sums(config))?;
         let modulated = r.bool("cut: modulated")?;
+        let slots = visibility_slots(count, config);
+        let mut visibility = Vec::with_capacity(slots.min(r.left() / 4));
+        for _ in 0..slots {
+            visibility.push(r.check("cut: visibility", Reader::f32, |v| {
+                (MIN_VISIBILITY..=1.0).contains(v)
+            })?);
+        }
+        let (seen, seen_records) = if slots > 0 {
+            let seen = SumBuffer::read(r, "cut: visibility sums", config.accumulation, 2 * slots)?;
+            (seen, Counter::with(r.u64("cut: visibility records")?))
+        } else {
+            (SumBuffer::new(0, config.accumulation), Counter::new())
+        };
         let cut = Self {
             nodes,
             sums,
@@ -157,6 +182,9 @@ impl GuidingCut {
             recorded,
             anchor,
             modulated,
+            visibility: visibility.into_boxed_slice(),
+            seen,
+            seen_records,
         };
         cut.check(rules.light_tree())
             .map_err(|_| Reader::invalid("cut: nodes", at))?;
@@ -169,6 +197,7 @@ impl GuidingCut {
         self.nodes == other.nodes
             && self.unbounded == other.unbounded
             && self.modulated == other.modulated
+            && self.visibility == other.visibility
     }
 
     /// Zeroes what was recorded since the last refinement (sums, anchor,
@@ -177,6 +206,8 @@ impl GuidingCut {
         self.sums.clear();
         self.anchor.clear();
         self.recorded.reset();
+        self.seen.clear();
+        self.seen_records.reset();
     }
 
     /// Adds `other`'s accumulating state (same layout) to this cut's.
@@ -184,10 +215,14 @@ impl GuidingCut {
         if !self.same_layout(other) {
             return false;
         }
-        if !(self.sums.merge(&other.sums) && self.anchor.merge(&other.anchor)) {
+        if !(self.sums.merge(&other.sums)
+            && self.anchor.merge(&other.anchor)
+            && self.seen.merge(&other.seen))
+        {
             return false;
         }
         self.recorded.merge(&other.recorded);
+        self.seen_records.merge(&other.seen_records);
         true
     }
 }

@@ -70,6 +70,7 @@ impl<H: LightHierarchy> CutRules<H> {
             }
         }
         let rebuilt = total > 0.0 && total.is_finite();
+        let mut old_nodes = Vec::new();
         if rebuilt {
             cut.modulated = plan.anchor.is_some();
             let mut sigma = config.sigma;
@@ -82,11 +83,17 @@ impl<H: LightHierarchy> CutRules<H> {
                 };
                 nodes = rebuild(self, &cut.nodes, &plan.sums, total, plan.anchor, sigma);
             }
-            cut.nodes = nodes;
+            old_nodes = core::mem::replace(&mut cut.nodes, nodes);
         }
         cut.sums
             .reset(sum_count(cut.nodes.len(), config.unbounded.count));
         cut.anchor.clear();
+        if !cut.visibility.is_empty() {
+            if !rebuilt {
+                old_nodes = cut.nodes.clone();
+            }
+            self.relearn_visibility(cut, &old_nodes);
+        }
         rebuilt
     }
 
@@ -108,10 +115,16 @@ impl<H: LightHierarchy> CutRules<H> {
             }
             None => cut.nodes.len(),
         };
+        // A learned visibility per slot: the value and two sums.
+        let per_slot = if cut.visibility.is_empty() {
+            0
+        } else {
+            4 + 2 * per_sum
+        };
         Growth {
-            fixed: (1 + unbounded) * per_sum + cut.anchor.bytes() + 4 * unbounded,
+            fixed: (1 + unbounded) * (per_sum + per_slot) + cut.anchor.bytes() + 4 * unbounded,
             nodes,
-            per_node: CutNode::BYTES + 2 * per_sum,
+            per_node: CutNode::BYTES + 2 * (per_sum + per_slot),
         }
     }
 

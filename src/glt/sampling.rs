@@ -529,6 +529,10 @@ impl<H: LightHierarchy> LightSampler for CutSampler<'_, H> {
     fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
         self.guide.pmf_exact(self.cut, ctx, light)
     }
+
+    fn visibility(&self, _ctx: &ShadingContext, light: LightId) -> f32 {
+        self.guide.visibility(self.cut, light)
+    }
 }
 
 impl<H: LightHierarchy> CutRules<H> {

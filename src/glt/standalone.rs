@@ -276,6 +276,33 @@ impl<H: LightHierarchy> Glt<H> {
         outcome
     }
 
+    /// Records what a next-event sample of `light` from `p` saw, for the
+    /// learned visibility ([`CutConfig::visibility`]): the value recorded
+    /// for it (0 when blocked) and the value it would have been without
+    /// occluders ([`CutRules::splat_visibility`]), into the cell holding
+    /// `p` (visibility is never carried into neighbouring cells). Bad input
+    /// is dropped and counted.
+    ///
+    /// [`CutConfig::visibility`]: super::CutConfig::visibility
+    pub fn splat_visibility(
+        &self,
+        p: Vec3,
+        light: LightId,
+        shadowed: f32,
+        unshadowed: f32,
+    ) -> SplatOutcome {
+        let outcome = match self.cut_at(p) {
+            Some(cut) => self
+                .guide
+                .splat_visibility(cut, light, shadowed, unshadowed),
+            None => SplatOutcome::Dropped,
+        };
+        if outcome == SplatOutcome::Dropped {
+            self.reject();
+        }
+        outcome
+    }
+
     #[inline]
     fn reject(&self) {
         self.dropped.count(DropReason::Light);
@@ -429,6 +456,12 @@ impl<H: LightHierarchy> LightSampler for Glt<H> {
         self.cut_at(ctx.position)
             .map_or(0.0, |cut| self.guide.pmf_exact(cut, ctx, light))
     }
+
+    /// The learned visibility of `light` in the cell of `ctx.position`.
+    fn visibility(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        self.cut_at(ctx.position)
+            .map_or(1.0, |cut| self.guide.visibility(cut, light))
+    }
 }
 
 /// A path vertex located in a [`Glt`] ([`Glt::vertex`]): light selection
@@ -487,6 +520,21 @@ impl<'g, H: LightHierarchy> GltVertex<'g, H> {
     }
 }
 
+impl<H: LightHierarchy> GltVertex<'_, H> {
+    /// [`Glt::splat_visibility`] at this vertex's cell.
+    #[inline]
+    pub fn splat_visibility(&self, light: LightId, shadowed: f32, unshadowed: f32) -> SplatOutcome {
+        let outcome = self
+            .glt
+            .guide
+            .splat_visibility(self.cut, light, shadowed, unshadowed);
+        if outcome == SplatOutcome::Dropped {
+            self.glt.reject();
+        }
+        outcome
+    }
+}
+
 impl<H: LightHierarchy> LightSampler for GltVertex<'_, H> {
     /// Applies the GLT's sampling rule with the located cell's cut.
     #[inline]
@@ -511,5 +559,10 @@ impl<H: LightHierarchy> LightSampler for GltVertex<'_, H> {
     #[inline]
     fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
         self.glt.guide.pmf_exact(self.cut, ctx, light)
+    }
+
+    /// The learned visibility of `light` in the located cell.
+    fn visibility(&self, _ctx: &ShadingContext, light: LightId) -> f32 {
+        self.glt.guide.visibility(self.cut, light)
     }
 }

@@ -103,6 +103,15 @@ pub trait LightSampler {
     fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
         f64::from(self.pmf(ctx, light))
     }
+
+    /// What the sampler learned of `light`'s visibility at `ctx`: the
+    /// fraction of its unshadowed contribution that arrives, in
+    /// `[1/64, 1]`. Resampled light choice ([`crate::resampling`]) puts it
+    /// on its target. 1 for samplers that learn none (the default), and
+    /// for the GLT unless [`crate::glt::CutConfig::visibility`] is on.
+    fn visibility(&self, _ctx: &ShadingContext, _light: LightId) -> f32 {
+        1.0
+    }
 }
 
 /// A borrowed or boxed sampler is a sampler (every method forwarded,
@@ -133,6 +142,11 @@ macro_rules! forward_sampler {
             #[inline]
             fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
                 (**self).pmf_exact(ctx, light)
+            }
+
+            #[inline]
+            fn visibility(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+                (**self).visibility(ctx, light)
             }
         }
     )*};

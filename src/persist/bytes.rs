@@ -8,7 +8,7 @@ use alloc::vec::Vec;
 pub(crate) const MAGIC: [u8; 8] = *b"GUIDING\0";
 
 /// The format version this build writes, and the newest it reads.
-pub(crate) const FORMAT_VERSION: u32 = 1;
+pub(crate) const FORMAT_VERSION: u32 = 2;
 
 /// Bytes of the header: magic, format version, crate version (three
 /// `u16`), kind, payload length, checksum.
@@ -124,12 +124,19 @@ pub(crate) fn crate_version() -> [u16; 3] {
 pub(crate) struct Reader<'a> {
     buf: &'a [u8],
     pos: usize,
+    /// The format version of the buffer (older layouts keep their
+    /// reading paths).
+    version: u32,
 }
 
 impl<'a> Reader<'a> {
     /// The payload of `bytes` after checking its header for `kind`.
     pub(crate) fn open(bytes: &'a [u8], kind: Kind) -> Result<Self, LoadError> {
-        let mut r = Reader { buf: bytes, pos: 0 };
+        let mut r = Reader {
+            buf: bytes,
+            pos: 0,
+            version: 0,
+        };
         let magic = r.take(8, "magic")?;
         if magic != MAGIC {
             return Err(LoadError::NotGuidingData);
@@ -141,6 +148,7 @@ impl<'a> Reader<'a> {
                 supported: FORMAT_VERSION,
             });
         }
+        r.version = version;
         for _ in 0..3 {
             r.u16("crate version")?;
         }
@@ -172,6 +180,16 @@ impl<'a> Reader<'a> {
             return Err(LoadError::Checksum);
         }
         Ok(r)
+    }
+
+    /// Bytes left to read.
+    pub(crate) fn left(&self) -> usize {
+        self.buf.len() - self.pos
+    }
+
+    /// The format version the buffer was written with.
+    pub(crate) fn version(&self) -> u32 {
+        self.version
     }
 
     /// The error for `field` read at `offset`.
