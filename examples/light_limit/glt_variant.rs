@@ -88,6 +88,9 @@ impl GltVariant {
                         v.params = v.params.paper_rules();
                     }
                 }
+                "visibility" => {
+                    v.params.visibility = pick(kv, val, [("on", true), ("off", false)])?
+                }
                 "min-splats" => v.params.min_splats = num()? as u32,
                 "train-spp" => v.train_spp = num()? as u64,
                 _ => return Err(format!("`{kv}`: unknown key {k:?}")),

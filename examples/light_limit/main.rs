@@ -311,8 +311,20 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
             let name = format!("{} [bsdf-sampled]", variant.name);
             records.push(record(&name, &vb, 0, variant.train_spp));
         }
+        // Targets: blind, the GLT's learned visibility (when it learns
+        // one), the visibility at the point (the best a learned one could
+        // do).
+        let targets: &[(&str, u8)] = if variant.params.visibility {
+            &[
+                ("unshadowed", 0),
+                ("x learned visibility", 1),
+                ("x visibility", 2),
+            ]
+        } else {
+            &[("unshadowed", 0), ("x visibility", 2)]
+        };
         for &m in &args.resample {
-            for oracle in [false, true] {
+            for &(target, kind) in targets {
                 let v: Vec<f64> = points
                     .par_iter()
                     .map(|t| {
@@ -322,12 +334,18 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
                             .iter()
                             .map(|l| f64::from(glt.pmf(&ctx, l.light)))
                             .collect();
-                        let vis = variance::visibilities(t, oracle, 0.05);
+                        let vis = match kind {
+                            1 => t
+                                .lights
+                                .iter()
+                                .map(|l| f64::from(glt.visibility(&ctx, l.light)))
+                                .collect(),
+                            k => variance::visibilities(t, k == 2, 0.05),
+                        };
                         let (nee, bsdf) = variance::resampled_parts(t, &pmfs, &vis, m);
                         nee + bsdf
                     })
                     .collect();
-                let target = if oracle { "x visibility" } else { "unshadowed" };
                 let name = format!("{} resampled M={m} ({target})", variant.name);
                 records.push(record(&name, &v, 0, variant.train_spp));
             }

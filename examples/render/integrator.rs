@@ -126,6 +126,20 @@ fn splat_light(guides: &Guides, v: &Vertex, light: LightId, value: f32, s: &mut 
     }
 }
 
+/// Records what a next-event sample of `light` from `v` saw, for the
+/// cuts' learned visibility: the value it recorded (0 when blocked) and
+/// the value it would have recorded unoccluded.
+#[inline]
+fn splat_visibility(guides: &Guides, v: &Vertex, light: LightId, seen: f32, unshadowed: f32) {
+    if let Some(glt) = guides.glt {
+        glt.splat_visibility(v.pos, light, seen, unshadowed);
+    } else if let Some(at) = &v.at {
+        at.splat_visibility(light, seen, unshadowed);
+    } else if let Some(field) = guides.field {
+        field.splat_visibility(v.pos, light, seen, unshadowed);
+    }
+}
+
 /// The scalar a light splat starts from: the luminance of the arriving
 /// radiance `le`, times `f cos` with contribution splats.
 #[inline]
@@ -285,14 +299,19 @@ pub fn radiance<'a>(
                         LightId::Emitter(e) => e,
                         LightId::Unbounded(_) => NO_EMITTER,
                     };
-                    if !scene.occluded(o, lp.wi, lp.dist, target) {
-                        let c = f * lp.radiance * d.factor;
-                        if c.is_finite() {
+                    let visible = !scene.occluded(o, lp.wi, lp.dist, target);
+                    let c = f * lp.radiance * d.factor;
+                    if c.is_finite() {
+                        let value = splat_value(guides, f, lp.radiance) * d.factor;
+                        if visible {
                             recorder.add_radiance(c);
                             if train_light {
-                                let value = splat_value(guides, f, lp.radiance) * d.factor;
                                 splat_light(guides, &here, ls.light, value, s);
                             }
+                        }
+                        if train_light {
+                            let seen = if visible { value } else { 0.0 };
+                            splat_visibility(guides, &here, ls.light, seen, value);
                         }
                     }
                 }

@@ -133,6 +133,7 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
             SpatialFilter::Nearest
         },
         prior: args.prior,
+        visibility: false,
     };
     if args.paper_rules {
         params = params.paper_rules();

@@ -109,6 +109,9 @@ pub struct GuideParams {
     pub glt_filter: SpatialFilter,
     /// The GLT's defensive prior.
     pub prior: Prior,
+    /// Whether the cuts learn each cluster's visibility from the NEE
+    /// records ([`CutConfig::visibility`]).
+    pub visibility: bool,
 }
 
 impl Default for GuideParams {
@@ -127,6 +130,7 @@ impl Default for GuideParams {
             contribution_splats: false,
             glt_filter: GltConfig::default().filter,
             prior: cut.prior,
+            visibility: cut.visibility,
         }
     }
 }
@@ -182,6 +186,7 @@ fn cut_config(scene: &Scene, params: &GuideParams) -> CutConfig {
         modulation: params.modulation,
         prior: params.prior,
         unbounded: scene.unbounded_lights,
+        visibility: params.visibility,
         ..CutConfig::default()
     }
 }

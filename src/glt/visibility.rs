@@ -43,9 +43,10 @@ impl<H: LightHierarchy> CutRules<H> {
     /// been without occluders (the same scalar as
     /// [`CutRules::splat`]'s). A sample the renderer skipped (a zero
     /// BSDF, say) is not a record. [`SplatOutcome::Zero`] when the
-    /// configuration learns no visibility or `unshadowed` is 0;
-    /// [`SplatOutcome::Dropped`] for values that are negative, not finite,
-    /// or with `shadowed > unshadowed`, and lights out of range. `&self`:
+    /// configuration learns no visibility (then nothing else is looked at
+    /// but the values) or `unshadowed` is 0; [`SplatOutcome::Dropped`] for
+    /// values that are negative, not finite, or with `shadowed >
+    /// unshadowed`, and, while learning, lights out of range. `&self`:
     /// any number of threads at once.
     pub fn splat_visibility(
         &self,
@@ -58,6 +59,11 @@ impl<H: LightHierarchy> CutRules<H> {
         if !(valid(shadowed) && valid(unshadowed) && shadowed <= unshadowed) {
             return SplatOutcome::Dropped;
         }
+        if cut.visibility.is_empty() {
+            // Nothing to learn: no lookup either, so the renderer can make
+            // these records whatever the configuration.
+            return SplatOutcome::Zero;
+        }
         let index = match light {
             LightId::Emitter(e) => cut.slot_of(self.light_tree(), e),
             LightId::Unbounded(i) => {
@@ -67,7 +73,7 @@ impl<H: LightHierarchy> CutRules<H> {
         let Some(index) = index else {
             return SplatOutcome::Dropped;
         };
-        if cut.visibility.is_empty() || unshadowed == 0.0 {
+        if unshadowed == 0.0 {
             return SplatOutcome::Zero;
         }
         cut.seen.add(2 * index, shadowed);
