@@ -1279,3 +1279,71 @@ fn modulation_reproduces_the_learned_cut_at_the_anchor_and_follows_importance() 
     let mut rng = Rand::new(5);
     assert_sample_matches_pmf(&modulated, &b, &near, &mut rng, 200);
 }
+
+/// Below the cut, `BelowCut::Importance` is the light BVH's importance walk
+/// restricted to the slot's subtree: for the initial cut (its root split by
+/// power), no defensive prior and unmodulated probabilities, the pmf of
+/// light `l` on side `s` is `p_s * bvh(l) / bvh(subtree s)`, where `bvh`
+/// is the `ImportanceTreeSampler`'s pmf. With `BelowCut::Power` it is not
+/// (the control). Importance is evaluated whatever the prior rule (a
+/// mutant that evaluated it only for an importance prior went unseen).
+#[test]
+fn below_cut_importance_is_the_importance_walk() {
+    let mut rng = Rand::new(41);
+    let lights = lights_in_box(&mut rng, 300, 10.0);
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let bvh = guiding::ImportanceTreeSampler::new(&tree);
+    let [left, right] = tree.children(tree.root().unwrap()).unwrap();
+    let under = |n: u32| {
+        let mut out = Vec::new();
+        let mut stack = vec![n];
+        while let Some(k) = stack.pop() {
+            match tree.children(k) {
+                Some(c) => stack.extend(c),
+                None => out.push(tree.emitter(k).unwrap()),
+            }
+        }
+        out
+    };
+    let sides = [under(left), under(right)];
+    let (pl, pr) = {
+        let (l, r) = (f64::from(tree.power(left)), f64::from(tree.power(right)));
+        (l / (l + r), r / (l + r))
+    };
+    for below_cut in [BelowCut::Importance, BelowCut::Power] {
+        for prior in [Prior::Power, Prior::Importance] {
+            let config = CutConfig {
+                alpha: 0.0,
+                below_cut,
+                modulation: Modulation::None,
+                prior,
+                ..CutConfig::default()
+            };
+            let guide = CutRules::new(&tree, config).unwrap();
+            let cut = guide.new_cut();
+            let mut worst = 0.0f64;
+            let mut rng = Rand::new(42);
+            for _ in 0..20 {
+                let ctx = ShadingContext::on_surface(rng.point(12.0), rng.dir());
+                for (s, side) in sides.iter().enumerate() {
+                    let p_side = if s == 0 { pl } else { pr };
+                    let sub: f64 = side
+                        .iter()
+                        .map(|&e| bvh.pmf_exact(&ctx, LightId::Emitter(e)))
+                        .sum();
+                    for &e in side {
+                        let want = p_side * bvh.pmf_exact(&ctx, LightId::Emitter(e)) / sub;
+                        let got = guide.pmf_exact(&cut, &ctx, LightId::Emitter(e));
+                        worst = worst.max((got - want).abs() / want.max(1e-12));
+                    }
+                }
+            }
+            match below_cut {
+                // The GLT reads importance from its decoded f32 table, the
+                // BVH computes it in f64: a few 1e-4 apart at some points.
+                BelowCut::Importance => assert!(worst < 5e-3, "{prior:?}: off by {worst}"),
+                BelowCut::Power => assert!(worst > 0.1, "{prior:?}: the control, {worst}"),
+            }
+        }
+    }
+}
