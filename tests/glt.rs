@@ -1347,3 +1347,69 @@ fn below_cut_importance_is_the_importance_walk() {
         }
     }
 }
+
+/// `CutRules::sampler` is the cut as a `LightSampler`: the same draws,
+/// pmfs and visibility as the rules' own calls, and not empty.
+#[test]
+fn a_cut_as_a_light_sampler_answers_as_its_rules() {
+    let mut rng = Rand::new(51);
+    let lights = lights_in_box(&mut rng, 200, 10.0);
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let config = CutConfig {
+        visibility: true,
+        ..CutConfig::default()
+    };
+    let guide = CutRules::new(&tree, config).unwrap();
+    let mut cut = guide.new_cut();
+    for _ in 0..2000 {
+        let e = rng.below(200);
+        guide.splat_from(&cut, rng.point(5.0), LightId::Emitter(e), rng.f());
+        guide.splat_visibility(&cut, LightId::Emitter(e), 0.25, 1.0);
+    }
+    guide.refine(&mut cut);
+    let s = guide.sampler(&cut);
+    assert!(!s.is_empty());
+    for _ in 0..500 {
+        let ctx = ShadingContext::on_surface(rng.point(8.0), rng.dir());
+        let (u, u64) = (rng.f(), rng.f64());
+        assert_eq!(s.sample(&ctx, u), guide.sample(&cut, &ctx, u));
+        assert_eq!(
+            s.sample_exact(&ctx, u64),
+            guide.sample_exact(&cut, &ctx, u64)
+        );
+        let l = LightId::Emitter(rng.below(200));
+        assert_eq!(s.pmf(&ctx, l), guide.pmf(&cut, &ctx, l));
+        assert_eq!(s.pmf_exact(&ctx, l), guide.pmf_exact(&cut, &ctx, l));
+        assert_eq!(s.visibility(&ctx, l), guide.visibility(&cut, l));
+        assert!(s.visibility(&ctx, l) < 0.5, "learned from 1/4 records");
+    }
+}
+
+/// A light whose pmf rounds to 0 in `f32` is never returned, even by the
+/// number that walks straight to it (`u = 0` takes every left branch): a
+/// sample's pmf is in `(0, 1]`, as `LightSample` promises.
+#[test]
+fn a_pmf_that_rounds_to_zero_is_never_sampled() {
+    let lights = [
+        Emitter::point(Vec3::new(-1.0, 0.0, 0.0), 1e-30),
+        Emitter::point(Vec3::new(1.0, 0.0, 0.0), 1e30),
+    ];
+    let tree = LightTree::build(&lights[..], BuildHeuristic::Sarh).unwrap();
+    let [left, _] = tree.children(tree.root().unwrap()).unwrap();
+    assert_eq!(tree.emitter(left), Some(0), "the dim light is on the left");
+    for config in [
+        CutConfig::default(),
+        CutConfig::default().with_paper_rules(),
+    ] {
+        let guide = CutRules::new(&tree, config).unwrap();
+        let cut = guide.new_cut();
+        let ctx = ShadingContext::at(Vec3::new(0.0, 1.0, 0.0));
+        assert!(guide.pmf_exact(&cut, &ctx, LightId::Emitter(0)) < 1e-45);
+        assert_eq!(guide.pmf(&cut, &ctx, LightId::Emitter(0)), 0.0);
+        for u in [0.0f32, f32::from_bits(1), 1e-30] {
+            if let Some(s) = guide.sample(&cut, &ctx, u) {
+                assert!(s.pmf > 0.0, "{config:?} u = {u}: {s:?}");
+            }
+        }
+    }
+}
