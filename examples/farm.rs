@@ -140,6 +140,7 @@ fn render_passes(
         field: Some(field),
         train,
         contribution_splats: false,
+        resample: 0,
     };
     let settings = settings(args);
     let len = (3 * args.width * args.height) as usize;

@@ -1383,6 +1383,17 @@ fn a_cut_as_a_light_sampler_answers_as_its_rules() {
         assert_eq!(s.visibility(&ctx, l), guide.visibility(&cut, l));
         assert!(s.visibility(&ctx, l) < 0.5, "learned from 1/4 records");
     }
+    // Lights without power and no unbounded light: empty, and says so.
+    let dark: Vec<Emitter> = lights
+        .iter()
+        .map(|e| Emitter { power: 0.0, ..*e })
+        .collect();
+    let dark_tree = LightTree::build(&dark, BuildHeuristic::Sarh).unwrap();
+    let dark_rules = CutRules::new(&dark_tree, CutConfig::default()).unwrap();
+    let dark_cut = dark_rules.new_cut();
+    assert!(dark_rules.is_empty() && dark_rules.sampler(&dark_cut).is_empty());
+    let ctx = ShadingContext::at(Vec3::ZERO);
+    assert_eq!(dark_rules.sampler(&dark_cut).sample(&ctx, 0.5), None);
 }
 
 /// A light whose pmf rounds to 0 in `f32` is never returned, even by the

@@ -88,6 +88,19 @@ fn region_means(r: &Rendered) -> Vec<(f64, f64)> {
 /// than the methods' pooled mean, so a bias the guided methods share cannot
 /// pull the yardstick with it.
 fn methods_agree(name: &str, width: u32, height: u32, spp: u64) {
+    methods_agree_with(name, width, height, spp, &Method::ALL, |_| {});
+}
+
+/// [`methods_agree`] for `methods`, their parameters changed by `tweak`
+/// (the reference keeps the defaults).
+fn methods_agree_with(
+    name: &str,
+    width: u32,
+    height: u32,
+    spp: u64,
+    methods: &[Method],
+    tweak: impl Fn(&mut GuideParams),
+) {
     let scene = scenes::build(name, scenes::Size::Small).expect("known scene");
     let mut settings = Settings {
         width,
@@ -105,6 +118,7 @@ fn methods_agree(name: &str, width: u32, height: u32, spp: u64) {
             glt_filter: guiding::spatial::SpatialFilter::Nearest,
             prior: CutConfig::default().prior,
             visibility: false,
+            resample: 0,
         },
         seed: 1001,
         progress: false,
@@ -114,7 +128,8 @@ fn methods_agree(name: &str, width: u32, height: u32, spp: u64) {
     let reference = region_means(&run::render(&scene, Method::PtBvh, &settings));
     settings.budget = Budget::Spp(spp);
     settings.seed = 3;
-    let results: Vec<(Method, Vec<(f64, f64)>)> = Method::ALL
+    tweak(&mut settings.params);
+    let results: Vec<(Method, Vec<(f64, f64)>)> = methods
         .iter()
         .map(|&m| {
             let r = run::render(&scene, m, &settings);
@@ -169,6 +184,20 @@ fn many_lights_every_method_converges_to_the_same_image() {
     methods_agree("ring", 48, 36, 64);
 }
 
+/// Resampled NEE (8 candidates of the GLT, with its learned visibility)
+/// inside the full integrator, MIS and training included, against the
+/// same reference, on the many-light scene and with a sun and a sky.
+#[test]
+fn resampled_glt_methods_converge_to_the_same_image() {
+    let tweak = |p: &mut GuideParams| {
+        p.resample = 8;
+        p.visibility = true;
+    };
+    let glt = [Method::PtGlt, Method::PpgGlt];
+    methods_agree_with("ring", 48, 36, 64, &glt, tweak);
+    methods_agree_with("few-lights", 48, 36, 128, &glt, tweak);
+}
+
 #[test]
 fn environment_every_method_converges_to_the_same_image() {
     methods_agree("few-lights", 48, 36, 128);
@@ -201,6 +230,7 @@ fn guided_methods_train_their_structures() {
             glt_filter: guiding::spatial::SpatialFilter::Nearest,
             prior: CutConfig::default().prior,
             visibility: false,
+            resample: 0,
         },
         seed: 5,
         progress: false,

@@ -88,6 +88,7 @@ impl GltVariant {
                         v.params = v.params.paper_rules();
                     }
                 }
+                "resample" => v.params.resample = num()? as usize,
                 "visibility" => {
                     v.params.visibility = pick(kv, val, [("on", true), ("off", false)])?
                 }

@@ -77,6 +77,15 @@ pub struct Args {
     /// `importance` (the crate's default).
     #[arg(long, default_value = "importance", value_parser = parse_prior)]
     pub prior: Prior,
+    /// `pt-glt` and `ppg-glt` choose each NEE light by resampling this many
+    /// candidates of the GLT (`guiding::resampling`; at most 64); 0 or 1
+    /// sample the GLT directly (the default).
+    #[arg(long, default_value_t = 0)]
+    pub resample: usize,
+    /// The GLT's cuts learn each cluster's visibility from the NEE records
+    /// (`CutConfig::visibility`), the factor resampling puts on its target.
+    #[arg(long)]
+    pub visibility: bool,
     /// Run `pt-glt` and `ppg-glt` exactly as the paper describes: power
     /// below the cut, one distribution per cell, no defensive mixture
     /// (alpha 0), rebuild from any data (min-splats 0), jittered light

@@ -10,11 +10,12 @@ use crate::geometry::{NO_EMITTER, offset_origin};
 use crate::lights::luminance;
 use crate::rng::Sampler;
 use crate::scene::Scene;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use guiding::field::{FieldVertex, GuidingField};
 use guiding::glt::Glt;
-use guiding::mis::Convention;
+use guiding::mis::{Convention, resampled_light_sample};
 use guiding::path_recorder::{RadianceRecords, Segment};
+use guiding::resampling::{Evaluated, resample};
 use guiding::sd_tree::{SdCell, SdTree};
 use guiding::spatial::Jitter;
 use guiding::{LightId, LightSampler, LightTree, PathRecorder, ShadingContext};
@@ -37,7 +38,14 @@ pub struct Guides<'a> {
     /// Light splats carry the full contribution `f cos Le w / p` instead of
     /// the paper's `Le w / p` (without the BSDF and cosine).
     pub contribution_splats: bool,
+    /// Candidates of resampled next-event estimation
+    /// (`guiding::resampling`, at most [`MAX_CANDIDATES`]); 0 or 1 samples
+    /// the light sampler directly.
+    pub resample: usize,
 }
+
+/// The most candidates a resampled light choice draws.
+pub const MAX_CANDIDATES: usize = 64;
 
 /// The field's cell at a path vertex (`ppg-glt`): found once, it serves
 /// the vertex's queries and every record made there later.
@@ -274,16 +282,40 @@ pub fn radiance<'a>(
             None => guides.lights,
         };
 
-        // Next-event estimation.
-        if let Some(ls) = nee.sample(&ctx, s.next()) {
-            let u = s.next2();
-            let (point, delta) = match ls.light {
-                LightId::Emitter(e) => (scene.lights[e as usize].sample(p, u), false),
-                LightId::Unbounded(i) => {
-                    let light = &scene.unbounded[i as usize];
-                    (light.sample(n, u), light.is_delta())
-                }
+        // Next-event estimation: one light from the sampler, or the one
+        // resampling keeps of several candidates (each with its light point
+        // and the weight that replaces 1 / pmf).
+        let point_on = |light: LightId, u: Vec2| match light {
+            LightId::Emitter(e) => (scene.lights[e as usize].sample(p, u), false),
+            LightId::Unbounded(i) => {
+                let light = &scene.unbounded[i as usize];
+                (light.sample(n, u), light.is_delta())
+            }
+        };
+        let chosen = if guides.resample > 1 {
+            let m = guides.resample.min(MAX_CANDIDATES);
+            let mut cands = [0.0f32; MAX_CANDIDATES];
+            cands[..m].iter_mut().for_each(|c| *c = s.next());
+            let u_keep = s.next();
+            resample(nee, &ctx, &cands[..m], u_keep, |light, _| {
+                let (lp, delta) = point_on(light, s.next2());
+                let lp = lp?;
+                let (f, _) = mat.eval(n, wo, lp.wi);
+                // The unshadowed estimate, `f cos Le / p_l`.
+                let c = luminance(f * lp.radiance) / lp.pdf;
+                Some(Evaluated::new(c, (lp, delta)))
+            })
+            .map(|r| (r.light, r.pmf, Some(r.weight), Some(r.payload)))
+        } else {
+            nee.sample(&ctx, s.next())
+                .map(|ls| (ls.light, ls.pmf, None, None))
+        };
+        if let Some((light, pmf, weight, point)) = chosen {
+            let (point, delta) = match point {
+                Some((lp, delta)) => (Some(lp), delta),
+                None => point_on(light, s.next2()),
             };
+            let ls = guiding::LightSample { light, pmf };
             if let Some(lp) = point {
                 let (f, bsdf_pdf) = mat.eval(n, wo, lp.wi);
                 if f.max_element() > 0.0 && lp.pdf > 0.0 && lp.radiance.max_element() > 0.0 {
@@ -293,7 +325,10 @@ pub fn radiance<'a>(
                     } else {
                         dir_pdf(lp.wi, bsdf_pdf).0
                     };
-                    let d = Convention::PbrtV4.light_sample(ls.pmf, lp.pdf, p_dir);
+                    let d = match weight {
+                        Some(w) => resampled_light_sample(ls.pmf, w, lp.pdf, p_dir),
+                        None => Convention::PbrtV4.light_sample(ls.pmf, lp.pdf, p_dir),
+                    };
                     let o = offset_origin(p, n, lp.wi);
                     let target = match ls.light {
                         LightId::Emitter(e) => e,

@@ -133,7 +133,8 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
             SpatialFilter::Nearest
         },
         prior: args.prior,
-        visibility: false,
+        visibility: args.visibility,
+        resample: args.resample,
     };
     if args.paper_rules {
         params = params.paper_rules();

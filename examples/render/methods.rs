@@ -112,6 +112,8 @@ pub struct GuideParams {
     /// Whether the cuts learn each cluster's visibility from the NEE
     /// records ([`CutConfig::visibility`]).
     pub visibility: bool,
+    /// Candidates of resampled NEE for the GLT methods (0 or 1: none).
+    pub resample: usize,
 }
 
 impl Default for GuideParams {
@@ -131,6 +133,7 @@ impl Default for GuideParams {
             glt_filter: GltConfig::default().filter,
             prior: cut.prior,
             visibility: cut.visibility,
+            resample: 0,
         }
     }
 }

@@ -347,6 +347,11 @@ pub fn render_observed<'a>(
                 field: field.as_ref(),
                 train: trained && !it.is_last,
                 contribution_splats: settings.params.contribution_splats,
+                resample: if fixed.is_none() {
+                    settings.params.resample
+                } else {
+                    0
+                },
             };
             render_pass(scene, &guides, settings, spp, &mut pass_buf);
             stats.add_pass(&pass_buf);
