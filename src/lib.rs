@@ -33,6 +33,7 @@
 //! | --- | --- |
 //! | the GLT's sampling rule and pmf | `src/glt/sampling.rs` |
 //! | resampled light choice (candidates, reservoir, weight) | `src/resampling.rs` |
+//! | each cut cluster's learned visibility (the resampling target's factor) | `src/glt/visibility.rs` |
 //! | the light tree laid out for the GLT's walk | `src/glt/walk.rs` |
 //! | cut refinement (split / merge by sigma, `min_splats`) | `src/glt/refine.rs` |
 //! | the tables every cut reads (`CutRules`) | `src/glt/cut_rules.rs` |
