@@ -295,8 +295,12 @@ impl<H: LightHierarchy> LightSampler for GuidingField<H> {
             .map_or(0.0, |cell| self.guide.pmf_exact(&cell.cut, ctx, light))
     }
 
-    /// The learned visibility of `light` in the cell of `ctx.position`.
+    /// The learned visibility of `light` in the cell of `ctx.position`
+    /// (1, without a lookup, when none is learned).
     fn visibility(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        if !self.guide.config().visibility {
+            return 1.0;
+        }
         self.cell_at(ctx.position)
             .map_or(1.0, |cell| self.guide.visibility(&cell.cut, light))
     }

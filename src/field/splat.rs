@@ -90,11 +90,20 @@ impl<H: LightHierarchy> GuidingField<H> {
         shadowed: f32,
         unshadowed: f32,
     ) -> SplatOutcome {
-        let outcome = match self.cell_at(p) {
-            Some(cell) => self
-                .guide
-                .splat_visibility(&cell.cut, light, shadowed, unshadowed),
-            None => SplatOutcome::Dropped,
+        let outcome = if !self.guide.config().visibility {
+            // As the GLT's: values checked, `p` not looked up.
+            if crate::glt::valid_record(shadowed, unshadowed) {
+                SplatOutcome::Zero
+            } else {
+                SplatOutcome::Dropped
+            }
+        } else {
+            match self.cell_at(p) {
+                Some(cell) => self
+                    .guide
+                    .splat_visibility(&cell.cut, light, shadowed, unshadowed),
+                None => SplatOutcome::Dropped,
+            }
         };
         if outcome == SplatOutcome::Dropped {
             self.sd.dropped.count(crate::dropped::DropReason::Light);

@@ -56,3 +56,4 @@ pub use cut_node::{CutNode, Slot};
 pub use cut_rules::CutRules;
 pub use splat::SplatOutcome;
 pub use standalone::{Glt, GltCell, GltConfig, GltMemory, GltVertex};
+pub(crate) use visibility::valid_record;

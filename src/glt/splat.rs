@@ -54,6 +54,19 @@ impl GuidingCut {
 }
 
 impl<H: LightHierarchy> CutRules<H> {
+    /// Index of the sum (and learned visibility) of `light` in `cut`: its
+    /// slot ([`GuidingCut::slot_of`]) or its unbounded light's. `None` for
+    /// lights out of range and emitters without power.
+    #[inline]
+    pub(super) fn sum_of(&self, cut: &GuidingCut, light: LightId) -> Option<usize> {
+        match light {
+            LightId::Emitter(e) => cut.slot_of(self.light_tree(), e),
+            LightId::Unbounded(i) => {
+                (i < self.config().unbounded.count).then(|| cut.first_unbounded_sum() + i as usize)
+            }
+        }
+    }
+
     /// Records into `cut` `value`, the MIS-weighted direct-light estimate for `light`
     /// seen from a point of this cell, without BSDF and cosine: from NEE,
     /// `Le * T * w_mis / (pdf_solid_angle * pmf)`; from a BSDF-sampled
@@ -70,13 +83,7 @@ impl<H: LightHierarchy> CutRules<H> {
         if !(value >= 0.0 && value.is_finite()) {
             return SplatOutcome::Dropped;
         }
-        let index = match light {
-            LightId::Emitter(e) => cut.slot_of(self.light_tree(), e),
-            LightId::Unbounded(i) => {
-                (i < self.config().unbounded.count).then(|| cut.first_unbounded_sum() + i as usize)
-            }
-        };
-        let Some(index) = index else {
+        let Some(index) = self.sum_of(cut, light) else {
             return SplatOutcome::Dropped;
         };
         if value == 0.0 {

@@ -7,6 +7,7 @@ use super::cut::{CutMemory, GuidingCut};
 use super::cut_node::CutNode;
 use super::cut_rules::CutRules;
 use super::splat::SplatOutcome;
+use super::visibility::valid_record;
 use crate::dropped::{DropCounters, DropReason, DroppedSplats};
 use crate::emitter::ShadingContext;
 use crate::error::{ConfigError, Error};
@@ -291,11 +292,22 @@ impl<H: LightHierarchy> Glt<H> {
         shadowed: f32,
         unshadowed: f32,
     ) -> SplatOutcome {
-        let outcome = match self.cut_at(p) {
-            Some(cut) => self
-                .guide
-                .splat_visibility(cut, light, shadowed, unshadowed),
-            None => SplatOutcome::Dropped,
+        let outcome = if !self.config.cut.visibility {
+            // Nothing is learned: the values are checked, `p` is not
+            // looked up (the renderer may record whatever the
+            // configuration, at no cost).
+            if valid_record(shadowed, unshadowed) {
+                SplatOutcome::Zero
+            } else {
+                SplatOutcome::Dropped
+            }
+        } else {
+            match self.cut_at(p) {
+                Some(cut) => self
+                    .guide
+                    .splat_visibility(cut, light, shadowed, unshadowed),
+                None => SplatOutcome::Dropped,
+            }
         };
         if outcome == SplatOutcome::Dropped {
             self.reject();
@@ -457,8 +469,12 @@ impl<H: LightHierarchy> LightSampler for Glt<H> {
             .map_or(0.0, |cut| self.guide.pmf_exact(cut, ctx, light))
     }
 
-    /// The learned visibility of `light` in the cell of `ctx.position`.
+    /// The learned visibility of `light` in the cell of `ctx.position`
+    /// (1, without a lookup, when none is learned).
     fn visibility(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        if !self.config.cut.visibility {
+            return 1.0;
+        }
         self.cut_at(ctx.position)
             .map_or(1.0, |cut| self.guide.visibility(cut, light))
     }

@@ -55,8 +55,7 @@ impl<H: LightHierarchy> CutRules<H> {
         shadowed: f32,
         unshadowed: f32,
     ) -> SplatOutcome {
-        let valid = |x: f32| x >= 0.0 && x.is_finite();
-        if !(valid(shadowed) && valid(unshadowed) && shadowed <= unshadowed) {
+        if !valid_record(shadowed, unshadowed) {
             return SplatOutcome::Dropped;
         }
         if cut.visibility.is_empty() {
@@ -64,13 +63,7 @@ impl<H: LightHierarchy> CutRules<H> {
             // these records whatever the configuration.
             return SplatOutcome::Zero;
         }
-        let index = match light {
-            LightId::Emitter(e) => cut.slot_of(self.light_tree(), e),
-            LightId::Unbounded(i) => {
-                (i < self.config().unbounded.count).then(|| cut.first_unbounded_sum() + i as usize)
-            }
-        };
-        let Some(index) = index else {
+        let Some(index) = self.sum_of(cut, light) else {
             return SplatOutcome::Dropped;
         };
         if unshadowed == 0.0 {
@@ -88,11 +81,7 @@ impl<H: LightHierarchy> CutRules<H> {
         if cut.visibility.is_empty() {
             return 1.0;
         }
-        let index = match light {
-            LightId::Emitter(e) => cut.slot_of(self.light_tree(), e),
-            LightId::Unbounded(i) => Some(cut.first_unbounded_sum() + i as usize),
-        };
-        index
+        self.sum_of(cut, light)
             .and_then(|i| cut.visibility.get(i).copied())
             .unwrap_or(1.0)
     }
@@ -133,6 +122,14 @@ impl<H: LightHierarchy> CutRules<H> {
         cut.seen.reset(2 * (new_slots + k));
         cut.seen_records.reset();
     }
+}
+
+/// Whether a visibility record's values can be taken: finite, not
+/// negative, the shadowed at most the unshadowed.
+#[inline]
+pub(crate) fn valid_record(shadowed: f32, unshadowed: f32) -> bool {
+    let valid = |x: f32| x >= 0.0 && x.is_finite();
+    valid(shadowed) && valid(unshadowed) && shadowed <= unshadowed
 }
 
 /// Each old slot's (then unbounded light's) estimate and unshadowed sum.
