@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{Rand, scene, two_rooms, value};
+use common::{Rand, scene, two_rooms, unshadowed, value};
 use glam::Vec3;
 use guiding::field::{FieldConfig, GuidingField};
 use guiding::glt::{CutConfig, Glt, GltConfig};
@@ -39,12 +39,11 @@ fn samples(seed: u64, n: usize) -> Vec<Sample> {
             let light = rng.below(80);
             let dir = rng.dir();
             let f = rng.range(0.5, 2.0);
-            let c = lights[light as usize].bounds.center();
             Sample {
                 p,
                 light,
                 light_value: value(&lights, light, p) * f,
-                unshadowed: lights[light as usize].power / (c - p).length_squared().max(1.0) * f,
+                unshadowed: unshadowed(&lights, light, p) * f,
                 dir,
                 radiance: 1.0 + 30.0 * dir.y.max(0.0).powi(6),
                 jitter: [rng.f(), rng.f(), rng.f()],

@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{Rand, scene, two_rooms, value};
+use common::{Rand, scene, two_rooms, unshadowed, value};
 use glam::Vec3;
 use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
@@ -107,12 +107,6 @@ fn truth(lights: &[guiding::Emitter], p: Vec3) -> f64 {
     (0..lights.len() as u32)
         .map(|e| f64::from(value(lights, e, p)))
         .sum()
-}
-
-/// The unshadowed contribution of light `e` at `p` (the wall ignored).
-fn unshadowed(lights: &[guiding::Emitter], e: u32, p: Vec3) -> f32 {
-    let c = lights[e as usize].bounds.center();
-    lights[e as usize].power / (c - p).length_squared().max(1.0)
 }
 
 /// Mean and standard error of `n` resampled estimates at `p`, the target

@@ -7,22 +7,16 @@
 
 mod common;
 
-use common::{Rand, scene, two_rooms, value};
+use common::{Rand, scene, two_rooms, unshadowed, value};
 use glam::Vec3;
 use guiding::glt::{CutConfig, Glt, GltConfig, SplatOutcome};
 use guiding::light_tree::BuildHeuristic;
 use guiding::resampling::{Evaluated, resample};
-use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
+use guiding::{LightId, LightSampler, LightTree, ShadingContext};
 
 fn tree() -> &'static LightTree {
     static TREE: std::sync::OnceLock<LightTree> = std::sync::OnceLock::new();
     TREE.get_or_init(|| LightTree::build(&two_rooms(), BuildHeuristic::Sarh).unwrap())
-}
-
-/// Light `e`'s contribution at `p` without the wall.
-fn unshadowed(lights: &[Emitter], e: u32, p: Vec3) -> f32 {
-    let c = lights[e as usize].bounds.center();
-    lights[e as usize].power / (c - p).length_squared().max(1.0)
 }
 
 fn config(visibility: bool) -> GltConfig {

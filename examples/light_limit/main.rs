@@ -311,6 +311,17 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
             let name = format!("{} [bsdf-sampled]", variant.name);
             records.push(record(&name, &vb, 0, variant.train_spp));
         }
+        // The shading context of a point and the trained GLT's pmf of each
+        // of its lights.
+        let glt_pmfs = |t: &PointTerms| {
+            let ctx = ShadingContext::on_surface(t.at.p, t.at.n);
+            let pmfs: Vec<f64> = t
+                .lights
+                .iter()
+                .map(|l| f64::from(glt.pmf(&ctx, l.light)))
+                .collect();
+            (ctx, pmfs)
+        };
         // Targets: blind, the GLT's learned visibility (when it learns
         // one), the visibility at the point (the best a learned one could
         // do).
@@ -328,12 +339,7 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
                 let v: Vec<f64> = points
                     .par_iter()
                     .map(|t| {
-                        let ctx = ShadingContext::on_surface(t.at.p, t.at.n);
-                        let pmfs: Vec<f64> = t
-                            .lights
-                            .iter()
-                            .map(|l| f64::from(glt.pmf(&ctx, l.light)))
-                            .collect();
+                        let (ctx, pmfs) = glt_pmfs(t);
                         let vis = match kind {
                             1 => t
                                 .lights
@@ -354,15 +360,7 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
         // light choice alone cannot remove), in the relMSE normalisation.
         let bsdf_only: Vec<f64> = points
             .par_iter()
-            .map(|t| {
-                let ctx = ShadingContext::on_surface(t.at.p, t.at.n);
-                let pmfs: Vec<f64> = t
-                    .lights
-                    .iter()
-                    .map(|l| f64::from(glt.pmf(&ctx, l.light)))
-                    .collect();
-                variance::parts(t, &pmfs).1
-            })
+            .map(|t| variance::parts(t, &glt_pmfs(t).1).1)
             .collect();
         println!(
             "  {}: trained {} spp in {:.1} s; the BSDF sample's part of its variance: {:.1}%",

@@ -162,6 +162,12 @@ pub fn value(lights: &[Emitter], e: u32, p: Vec3) -> f32 {
     if (c.x < 0.0) != (p.x < 0.0) {
         return 0.0;
     }
+    unshadowed(lights, e, p)
+}
+
+/// Contribution of light `e` at `p` as if the wall were not there.
+pub fn unshadowed(lights: &[Emitter], e: u32, p: Vec3) -> f32 {
+    let c = lights[e as usize].bounds.center();
     lights[e as usize].power / (c - p).length_squared().max(1.0)
 }
 
