@@ -220,6 +220,94 @@ fn header_errors_are_typed() {
     ));
 }
 
+/// The header holds the crate's version, and each error says exactly
+/// where: a header length short of the payload ends it at the right byte,
+/// a payload with bytes after the structure (length and checksum made to
+/// match: a hostile buffer) is refused where the structure ended, a count
+/// one item more than the bytes left could hold is refused at the count.
+/// Every error's message names its field and offset.
+#[test]
+fn errors_say_exactly_where() {
+    let tree = LightTree::build(&two_rooms(), BuildHeuristic::Sarh).unwrap();
+    let bytes = tree.to_bytes();
+    let version: Vec<u16> = env!("CARGO_PKG_VERSION")
+        .split(['.', '-'])
+        .take(3)
+        .map(|p| p.parse().unwrap())
+        .collect();
+    let header: Vec<u16> = bytes[12..18]
+        .chunks(2)
+        .map(|b| u16::from_le_bytes([b[0], b[1]]))
+        .collect();
+    assert_eq!(header, version);
+    let payload = bytes.len() - HEADER;
+    let set_len = |b: &mut Vec<u8>, len: usize| {
+        b[HEADER - 16..HEADER - 8].copy_from_slice(&(len as u64).to_le_bytes());
+    };
+    let mut short = bytes.clone();
+    set_len(&mut short, payload - 4);
+    assert_eq!(
+        LightTree::from_bytes(&short).unwrap_err(),
+        LoadError::TrailingBytes {
+            offset: bytes.len() - 4
+        }
+    );
+    let mut extra = bytes.clone();
+    extra.extend_from_slice(&[0; 4]);
+    set_len(&mut extra, payload + 4);
+    assert_eq!(
+        LightTree::from_bytes(&resealed(extra)).unwrap_err(),
+        LoadError::TrailingBytes {
+            offset: bytes.len()
+        }
+    );
+    // The node count follows the 24-byte scene box; nodes are 32 bytes.
+    let at = HEADER + 24;
+    let left = bytes.len() - (at + 8);
+    let mut hostile = bytes.clone();
+    hostile[at..at + 8].copy_from_slice(&((left / 32 + 1) as u64).to_le_bytes());
+    assert_eq!(
+        LightTree::from_bytes(&resealed(hostile)).unwrap_err(),
+        LoadError::Truncated {
+            field: "light tree: node count",
+            offset: at
+        }
+    );
+    let errors = [
+        LoadError::Truncated {
+            field: "some field",
+            offset: 1234,
+        },
+        LoadError::Invalid {
+            field: "some field",
+            offset: 1234,
+        },
+        LoadError::TrailingBytes { offset: 1234 },
+        LoadError::UnsupportedVersion {
+            found: 1234,
+            supported: 2,
+        },
+        LoadError::WrongKind {
+            expected: 1,
+            found: 1234,
+        },
+        LoadError::LightTreeMismatch {
+            saved: 0x1234,
+            given: 0,
+        },
+    ];
+    for e in errors {
+        let text = e.to_string();
+        assert!(text.contains("1234"), "{text}");
+        if matches!(e, LoadError::Truncated { .. } | LoadError::Invalid { .. }) {
+            assert!(text.contains("some field"), "{text}");
+        }
+    }
+    for e in [LoadError::NotGuidingData, LoadError::Checksum] {
+        assert!(!e.to_string().is_empty());
+    }
+}
+
 /// Whatever loads keeps the sampler contract: pmf sums to 1 and sampling
 /// returns exactly the pmf.
 fn assert_contract<H: guiding::LightHierarchy>(glt: &Glt<H>, n: u32, rng: &mut Rand) {

@@ -113,3 +113,90 @@ fn glt_vertex_equals_the_glt_by_position() {
     }
     assert!(by_pos.vertex(Vec3::INFINITY).is_none());
 }
+
+/// The field's vertex answers as the field by position: its cell is the
+/// field's `locate`, light choice, pmfs and the learned visibility (which
+/// differs from 1 once learned) are bit for bit the same, light and
+/// visibility records made through either learn the same; an empty field
+/// says so through both.
+#[test]
+fn field_vertex_equals_the_field_by_position() {
+    use guiding::field::{FieldConfig, GuidingField};
+    use guiding::glt::CutConfig;
+    let lights = two_rooms();
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let mut config = FieldConfig {
+        cut: CutConfig {
+            visibility: true,
+            ..CutConfig::default()
+        },
+        ..FieldConfig::default()
+    };
+    config.sd.spatial_threshold = 300.0;
+    let mut by_pos = GuidingField::new(&tree, scene(), config).unwrap();
+    let mut by_vertex = GuidingField::new(&tree, scene(), config).unwrap();
+    let mut rng = Rand::new(6);
+    for _ in 0..4 {
+        for _ in 0..4000 {
+            let p = rng.point(9.5);
+            let ctx = ShadingContext::at(p);
+            let u = rng.f();
+            let v = by_vertex.vertex(p).unwrap();
+            assert_eq!(by_pos.locate(p), Some(v.cell()));
+            let s = by_pos.sample(&ctx, u).unwrap();
+            assert_eq!(v.sample(&ctx, u), Some(s));
+            let LightId::Emitter(e) = s.light else {
+                panic!()
+            };
+            let x = value(&lights, e, p) / s.pmf;
+            let seed = rng.0.next_u64();
+            assert_eq!(
+                by_pos.splat_light(p, s.light, x, &mut Pcg32::seed_from_u64(seed)),
+                v.splat_light(s.light, x, &mut Pcg32::seed_from_u64(seed))
+            );
+            let d = (Vec3::Y + 0.3 * rng.dir()).normalize();
+            let radiance = rng.range(0.0, 3.0);
+            let seed = rng.0.next_u64();
+            assert_eq!(
+                by_pos.splat_radiance(p, d, radiance, UNIFORM_PDF, &mut Pcg32::seed_from_u64(seed)),
+                v.splat_radiance(d, radiance, UNIFORM_PDF, &mut Pcg32::seed_from_u64(seed))
+            );
+            // Half the unshadowed records arrive (a wall of sorts).
+            let unshadowed = 1.0 + rng.f();
+            let seen = if rng.f() < 0.5 { unshadowed } else { 0.0 };
+            assert_eq!(
+                by_pos.splat_visibility(p, s.light, seen, unshadowed),
+                v.splat_visibility(s.light, seen, unshadowed)
+            );
+        }
+        by_pos.refine();
+        by_vertex.refine();
+    }
+    assert!(by_pos.cell_count() > 1);
+    let mut learned = 0;
+    for _ in 0..500 {
+        let p = rng.point(9.5);
+        let ctx = ShadingContext::on_surface(p, rng.dir());
+        let v = by_vertex.vertex(p).unwrap();
+        assert_eq!(by_pos.locate(p), Some(v.cell()));
+        for e in 0..lights.len() as u32 {
+            let l = LightId::Emitter(e);
+            assert_eq!(
+                by_pos.pmf_exact(&ctx, l).to_bits(),
+                v.pmf_exact(&ctx, l).to_bits()
+            );
+            let vis = by_pos.visibility(&ctx, l);
+            assert_eq!(vis.to_bits(), v.visibility(&ctx, l).to_bits());
+            learned += usize::from(vis < 0.9);
+        }
+        let u = rng.f64();
+        assert_eq!(by_pos.sample_exact(&ctx, u), v.sample_exact(&ctx, u));
+    }
+    assert!(learned > 0, "no visibility learned");
+    assert!(by_pos.locate(Vec3::NAN).is_none());
+    assert!(!by_pos.is_empty() && !by_vertex.vertex(Vec3::ZERO).unwrap().is_empty());
+    let dark = [guiding::Emitter::point(Vec3::ZERO, 0.0)];
+    let dark_tree = LightTree::build(&dark[..], BuildHeuristic::Sarh).unwrap();
+    let empty = GuidingField::new(&dark_tree, scene(), config).unwrap();
+    assert!(empty.is_empty() && empty.vertex(Vec3::ZERO).unwrap().is_empty());
+}

@@ -68,11 +68,16 @@ mod tests {
         assert_eq!(LightTree::from_bytes(&first).unwrap().nodes(), a.nodes());
         assert_eq!(LightTree::from_bytes(&second).unwrap().nodes(), b.nodes());
         assert!(r.is_empty());
-        // A length over the limit is refused before reading the payload.
+        // A length over the limit is refused before reading the payload;
+        // one exactly at it is read.
+        let first_len = a.to_bytes().len() - HEADER_BYTES;
         assert_eq!(
-            read_from(&mut &stream[..], 8).unwrap_err().kind(),
+            read_from(&mut &stream[..], first_len - 1)
+                .unwrap_err()
+                .kind(),
             io::ErrorKind::InvalidData
         );
+        assert_eq!(read_from(&mut &stream[..], first_len).unwrap(), first);
         // Truncated.
         let cut = &stream[..HEADER_BYTES + 3];
         assert_eq!(
