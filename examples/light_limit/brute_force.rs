@@ -31,6 +31,9 @@ pub struct LightTerm {
     /// Its contributing samples from the evaluation set (`m` samples were
     /// drawn per light; the others contributed nothing).
     pub eval: Vec<NeeSample>,
+    /// The evaluation set's occluded samples (in front of the light, with a
+    /// non-zero BSDF): `g` is what they would contribute unoccluded.
+    pub occluded: Vec<NeeSample>,
     /// Mean of `(g / pdf_light)^2` over an independent, stratified
     /// held-out set of samples: the light's second moment, as a
     /// clairvoyant pmf would know it without seeing the samples that
@@ -147,12 +150,14 @@ pub fn measure(
         .map(LightId::Emitter)
         .chain((0..scene.unbounded.len() as u32).map(LightId::Unbounded));
     for light in ids {
-        let mut eval = Vec::new();
+        let (mut eval, mut occluded) = (Vec::new(), Vec::new());
         let mut unshadowed = 0.0;
         light_samples(scene, &at, light, (m, false), &mut s, |x, visible| {
             unshadowed += x.g / x.pdf_light;
             if visible {
                 eval.push(x);
+            } else {
+                occluded.push(x);
             }
         });
         let (mut m2, mut seen, mut all, mut m2u) = (0.0, 0.0, 0.0, 0.0);
@@ -171,6 +176,7 @@ pub fn measure(
         lights.push(LightTerm {
             light,
             eval,
+            occluded,
             held_out_m2: m2 / held.max(1) as f64,
             unshadowed: unshadowed / m as f64,
             held_out_visibility: if all > 0.0 { seen / all } else { 1.0 },
@@ -222,6 +228,7 @@ pub fn measure(
             lights.push(LightTerm {
                 light,
                 eval: Vec::new(),
+                occluded: Vec::new(),
                 held_out_m2: 0.0,
                 unshadowed: 0.0,
                 held_out_visibility: 1.0,

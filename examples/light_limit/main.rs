@@ -322,6 +322,18 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
                 .collect();
             (ctx, pmfs)
         };
+        // Each light's visibility factor in the target of `kind` (below).
+        let visibility_of = |t: &PointTerms, ctx: &ShadingContext, kind: u8| -> Vec<f64> {
+            match kind {
+                1 | 3 => t
+                    .lights
+                    .iter()
+                    .map(|l| f64::from(glt.visibility(ctx, l.light)))
+                    .map(|v| if kind == 3 { v.sqrt() } else { v })
+                    .collect(),
+                k => variance::visibilities(t, k == 2, 0.05),
+            }
+        };
         // Targets: blind, the GLT's learned visibility (when it learns
         // one), the visibility at the point (the best a learned one could
         // do).
@@ -329,31 +341,65 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
             &[
                 ("unshadowed", 0),
                 ("x learned visibility", 1),
+                ("x sqrt of learned visibility", 3),
                 ("x visibility", 2),
             ]
         } else {
             &[("unshadowed", 0), ("x visibility", 2)]
         };
+        // Proxies of the MIS weights: the candidate density, and the
+        // resampled density's approximation with the exact integral of the
+        // target at the point (the bound of any proxy of that form; not for
+        // the blind target).
+        let proxies = [
+            (variance::Proxy::Candidate, ""),
+            (
+                variance::Proxy::Resampled(None),
+                ", MIS by the resampled density",
+            ),
+        ];
         for &m in &args.resample {
-            for &(target, kind) in targets {
-                let v: Vec<f64> = points
-                    .par_iter()
-                    .map(|t| {
-                        let (ctx, pmfs) = glt_pmfs(t);
-                        let vis = match kind {
-                            1 => t
-                                .lights
-                                .iter()
-                                .map(|l| f64::from(glt.visibility(&ctx, l.light)))
-                                .collect(),
-                            k => variance::visibilities(t, k == 2, 0.05),
-                        };
-                        let (nee, bsdf) = variance::resampled_parts(t, &pmfs, &vis, m);
-                        nee + bsdf
-                    })
-                    .collect();
-                let name = format!("{} resampled M={m} ({target})", variant.name);
-                records.push(record(&name, &v, 0, variant.train_spp));
+            for &(proxy, proxy_name) in &proxies {
+                for &(target, kind) in targets {
+                    if kind == 0 && proxy != variance::Proxy::Candidate {
+                        continue;
+                    }
+                    let v: Vec<f64> = points
+                        .par_iter()
+                        .map(|t| {
+                            let (ctx, pmfs) = glt_pmfs(t);
+                            let vis = visibility_of(t, &ctx, kind);
+                            let (nee, bsdf) =
+                                variance::resampled_parts_with(t, &pmfs, &vis, m, proxy);
+                            nee + bsdf
+                        })
+                        .collect();
+                    let name = format!("{} resampled M={m} ({target}{proxy_name})", variant.name);
+                    records.push(record(&name, &v, 0, variant.train_spp));
+                }
+            }
+            // The BSDF sample resampled with the light candidates: one
+            // sample, no MIS weights.
+            for seen in [false, true] {
+                for &(target, kind) in targets {
+                    if seen && kind == 0 {
+                        continue;
+                    }
+                    let v: Vec<f64> = points
+                        .par_iter()
+                        .map(|t| {
+                            let (ctx, pmfs) = glt_pmfs(t);
+                            let vis = visibility_of(t, &ctx, kind);
+                            variance::bsdf_candidate_variance(t, &pmfs, &vis, m, seen)
+                        })
+                        .collect();
+                    let name = format!(
+                        "{} resampled M={m} + BSDF candidate ({target}{})",
+                        variant.name,
+                        if seen { ", the BSDF's seen" } else { "" }
+                    );
+                    records.push(record(&name, &v, 0, variant.train_spp));
+                }
             }
         }
         // How much of the variance is the BSDF sample's (which a better

@@ -169,6 +169,22 @@ pub fn relative(points: &[PointTerms], variances: &[f64]) -> f64 {
         / n
 }
 
+/// The density both strategies' MIS weights take for a resampled
+/// next-event sample (its true density is not known in closed form; any
+/// density that is a function of the sample alone keeps the combination
+/// unbiased).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Proxy {
+    /// The candidates' density `q = P p_l` (what the crate's `resample`
+    /// returns as the pmf).
+    Candidate,
+    /// The resampled density's usual approximation,
+    /// `m t q / (t + (m - 1) Z q)` (`t` the target, `Z` its integral at the
+    /// point): `q` at one candidate, `t / Z` at infinitely many. `None`
+    /// takes the exact `Z` at the point (the bound for any estimate of it).
+    Resampled(Option<f64>),
+}
+
 /// The variance of the estimator when its next-event sample is resampled:
 /// `m` candidates `x_j = (l_j, y_j)` drawn with the light pmf `pmf` and each
 /// light's own sampling (density `q = P p_l`), one kept in proportion to
@@ -192,25 +208,70 @@ pub fn relative(points: &[PointTerms], variances: &[f64]) -> f64 {
 /// expectations). At `m = 1` it is plain sampling by `pmf`. Every integral
 /// is over the same light samples as [`parts`].
 pub fn resampled_parts(t: &PointTerms, pmf: &[f64], visibility: &[f64], m: usize) -> (f64, f64) {
+    resampled_parts_with(t, pmf, visibility, m, Proxy::Candidate)
+}
+
+/// [`resampled_parts`] with both strategies' MIS weights taken from
+/// `proxy`: `f = g w_l` in the closed form, and the BSDF part integrated
+/// as [`parts`] does, with the proxy in place of `P p_l`.
+pub fn resampled_parts_with(
+    t: &PointTerms,
+    pmf: &[f64],
+    visibility: &[f64],
+    m: usize,
+    proxy: Proxy,
+) -> (f64, f64) {
     let n = t.m.max(1) as f64;
-    let m = m.max(1) as f64;
-    let (mut a, mut b, mut c, mut mean) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
-    for ((term, &p), &v) in t.lights.iter().zip(pmf).zip(visibility) {
-        if p.is_nan() || p <= 0.0 {
-            continue;
+    let mf = m.max(1) as f64;
+    let valid = |p: f64| !p.is_nan() && p > 0.0;
+    // The target's integral at the point.
+    let z: f64 = t
+        .lights
+        .iter()
+        .zip(pmf)
+        .zip(visibility)
+        .filter(|((_, p), _)| valid(**p))
+        .map(|((term, _), &v)| v * term.unshadowed)
+        .sum();
+    let density = |p: f64, x: &crate::brute_force::NeeSample, v: f64| {
+        let q = p * x.pdf_light;
+        match proxy {
+            Proxy::Candidate => q,
+            Proxy::Resampled(estimate) => {
+                let z = estimate.unwrap_or(z);
+                let target = x.g * v;
+                let d = target + (mf - 1.0) * z * q;
+                if d > 0.0 { mf * target * q / d } else { q }
+            }
         }
-        b += v * term.unshadowed;
+    };
+    let (mut a, mut c, mut mean) = (0.0f64, 0.0f64, 0.0f64);
+    let (mut b_mean, mut b_m2) = (0.0f64, 0.0f64);
+    for ((term, &p), &v) in t.lights.iter().zip(pmf).zip(visibility) {
+        let p = if valid(p) { p } else { 0.0 };
         for x in &term.eval {
-            let pl = p * x.pdf_light;
-            let w = pl * pl / (pl * pl + x.pdf_bsdf * x.pdf_bsdf);
-            let f = x.g * w; // visible samples only
-            a += f * f / (p * x.pdf_light * x.pdf_light) / n;
-            c += f * f / (x.g * v * x.pdf_light) / n;
-            mean += f / x.pdf_light / n;
+            let pp = if p > 0.0 { density(p, x, v) } else { 0.0 };
+            let pb = x.pdf_bsdf;
+            let d = pp * pp + pb * pb;
+            if d <= 0.0 {
+                continue;
+            }
+            if p > 0.0 {
+                let f = x.g * pp * pp / d; // visible samples only
+                a += f * f / (p * x.pdf_light * x.pdf_light) / n;
+                c += f * f / (x.g * v * x.pdf_light) / n;
+                mean += f / x.pdf_light / n;
+            }
+            if pb > 0.0 {
+                let y = x.g * pb / d;
+                let w = pb / x.pdf_light;
+                b_mean += y * w / n;
+                b_m2 += y * y * w / n;
+            }
         }
     }
-    let nee = (a / m + (1.0 - 1.0 / m) * b * c - mean * mean).max(0.0);
-    (nee, parts(t, pmf).1)
+    let nee = (a / mf + (1.0 - 1.0 / mf) * z * c - mean * mean).max(0.0);
+    (nee, (b_m2 - b_mean * b_mean).max(0.0))
 }
 
 /// The per-light visibilities of [`resampled_parts`]: all 1, or the
@@ -227,4 +288,78 @@ pub fn visibilities(t: &PointTerms, oracle: bool, floor: f64) -> Vec<f64> {
             }
         })
         .collect()
+}
+
+/// The variance of the one-sample estimator that resamples `m` light
+/// candidates *and the BSDF sample* together (ReSTIR's initial candidates;
+/// the BSDF sample is traced anyway to continue the path): candidate `i`
+/// from strategy `k_i` gets the weight `w_i = target_k(x_i) / D(x_i)`, with
+/// the balance heuristic's `D = m P p_l + p_b`, one is kept in proportion
+/// to its weight and `f(x) W`, `W = sum_i w_i / target_k(x)`, is the
+/// estimate. There is no second sample and no MIS weight: the emission a
+/// BSDF sample finds counts only if it is kept.
+///
+/// Each strategy may have its own target (the estimate divides the kept
+/// candidate's integrand by its own target, so the estimator stays
+/// unbiased): the light candidates' is the unshadowed `g` times
+/// `visibility[i]`; the BSDF candidate's the same, or, with `bsdf_seen`,
+/// `g` alone (its ray reached the light: it is visible).
+///
+/// For independent candidates (`m` i.i.d. from the light strategy, one
+/// from the BSDF's), with `A_k = int q_k f^2 / (target_k D)` and
+/// `B_k = E[w | strategy k] = int q_k target_k / D`:
+///
+/// ```text
+/// E[Y^2] = int f^2 / D + (m A_l + A_b) (m B_l + B_b) - m A_l B_l - A_b B_b
+/// ```
+///
+/// (condition on the candidates as in [`resampled_parts`]: the pairs `s ==
+/// k` give `int f^2 / D`, the others factor into the strategies' terms).
+/// The BSDF strategy's density of a light point is `p_b V`: an occluded
+/// light point is never its candidate (its ray stops at the occluder), so
+/// `B_b` runs over visible points only, `B_l` over all of them. Integrals
+/// are over the same light samples as [`parts`], the occluded ones kept for
+/// `B_l`.
+pub fn bsdf_candidate_variance(
+    t: &PointTerms,
+    pmf: &[f64],
+    visibility: &[f64],
+    m: usize,
+    bsdf_seen: bool,
+) -> f64 {
+    let n = t.m.max(1) as f64;
+    let mf = m as f64;
+    let (mut f2d, mut mean) = (0.0f64, 0.0f64);
+    let (mut a_l, mut a_b, mut b_l, mut b_b) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for ((term, &p), &v) in t.lights.iter().zip(pmf).zip(visibility) {
+        let p = if p.is_nan() || p <= 0.0 { 0.0 } else { p };
+        let v_b = if bsdf_seen { 1.0 } else { v };
+        for (x, visible) in term
+            .eval
+            .iter()
+            .map(|x| (x, true))
+            .chain(term.occluded.iter().map(|x| (x, false)))
+        {
+            let q = p * x.pdf_light;
+            let pb = x.pdf_bsdf;
+            let d = mf * q + pb;
+            if d <= 0.0 {
+                continue;
+            }
+            let (t_l, t_b) = (x.g * v, x.g * v_b);
+            // Integrals in the light-sample domain: h / p_l per sample.
+            let per = 1.0 / (x.pdf_light * n);
+            b_l += q * t_l / d * per;
+            if visible {
+                let f = x.g;
+                f2d += f * f / d * per;
+                a_l += q * f * f / (t_l * d) * per;
+                a_b += pb * f * f / (t_b * d) * per;
+                b_b += pb * t_b / d * per;
+                mean += f * per;
+            }
+        }
+    }
+    let m2 = f2d + (mf * a_l + a_b) * (mf * b_l + b_b) - mf * a_l * b_l - a_b * b_b;
+    (m2 - mean * mean).max(0.0)
 }
