@@ -137,7 +137,9 @@ impl Convention {
 }
 
 /// The light sample of a resampled light choice
-/// ([`crate::resampling::resample`]) under pbrt-v4's convention: the MIS
+/// ([`crate::resampling::resample`]) whose BSDF sample is kept apart (not
+/// resampled as a candidate: then there is no MIS weight), under pbrt-v4's
+/// convention: the MIS
 /// weight against the BSDF sample takes the candidate density
 /// `pmf * pdf_light` as the light strategy's (proxy) density, as the BSDF
 /// sample's weight [`Convention::bsdf_sample`] does with the pmf of the

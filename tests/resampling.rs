@@ -52,7 +52,7 @@ fn the_reservoir_keeps_each_candidate_with_its_share() {
         let mut kept = vec![0u32; lights.len()];
         for g in 0..grid {
             let u = (g as f32 + 0.5) / grid as f32;
-            let r = resample(&s, &ctx, &cands, u, |l, j| {
+            let r = resample(&s, &ctx, &cands, u, None, |l, j| {
                 assert_eq!(LightId::Emitter(lights[j]), l);
                 Some(Evaluated::new(contributions[lights[j] as usize], j))
             })
@@ -86,7 +86,7 @@ fn one_candidate_is_plain_sampling() {
         let ctx = ShadingContext::at(rng.point(9.0));
         let u = rng.f();
         let plain = s.sample(&ctx, u).unwrap();
-        let r = resample(&s, &ctx, &[u], rng.f(), |_, _| {
+        let r = resample(&s, &ctx, &[u], rng.f(), None, |_, _| {
             Some(Evaluated::new(2.5, ()))
         })
         .unwrap();
@@ -129,12 +129,11 @@ fn estimate(
     let mut cands = vec![0.0f32; m];
     for _ in 0..n {
         cands.iter_mut().for_each(|c| *c = rng.f());
-        let r = resample(s, &ctx, &cands, rng.f(), |l, _| {
+        let r = resample(s, &ctx, &cands, rng.f(), None, |l, _| {
             let LightId::Emitter(e) = l else { return None };
             Some(Evaluated {
-                contribution: unshadowed(lights, e, p),
                 factor: factor(e),
-                payload: e,
+                ..Evaluated::new(unshadowed(lights, e, p), e)
             })
         });
         let x = r.map_or(0.0, |r| {
@@ -224,7 +223,8 @@ fn resampled_estimates_are_unbiased() {
 
 /// Candidates whose evaluation is missing, zero, negative, NaN or infinite
 /// are never kept; hostile factors count as 1; no candidate that
-/// contributes gives `None`; an empty candidate list gives `None`.
+/// contributes gives `None`; an empty candidate list gives `None`;
+/// candidates with densities that cannot be used are ignored.
 #[test]
 fn bad_evaluations_are_ignored() {
     let s = UniformSampler::new(4);
@@ -238,22 +238,21 @@ fn bad_evaluations_are_ignored() {
         Some(f32::INFINITY),
     ];
     for b in bad {
-        let none = resample(&s, &ctx, &cands, 0.5, |_, _| {
+        let none = resample(&s, &ctx, &cands, 0.5, None, |_, _| {
             b.map(|c| Evaluated::new(c, ()))
         });
         assert!(none.is_none(), "{b:?}");
     }
     for u in [0.0, 0.3, 0.7, 0.999_999] {
-        let r = resample(&s, &ctx, &cands, u, |l, j| {
+        let r = resample(&s, &ctx, &cands, u, None, |l, j| {
             let c = if j == 2 {
                 1.0
             } else {
                 [0.0, f32::NAN, 0.0, -3.0][j]
             };
             Some(Evaluated {
-                contribution: c,
                 factor: [f32::NAN, 0.0, f32::INFINITY, -1.0][j],
-                payload: l,
+                ..Evaluated::new(c, l)
             })
         })
         .unwrap();
@@ -261,7 +260,48 @@ fn bad_evaluations_are_ignored() {
         // Factor infinite counts as 1: weight = (c/pmf / 4) / c = 1.
         assert!((r.weight - 1.0).abs() < 1e-6, "{}", r.weight);
     }
-    assert!(resample(&s, &ctx, &[], 0.5, |_, _| Some(Evaluated::new(1.0, ()))).is_none());
+    assert!(
+        resample(&s, &ctx, &[], 0.5, None, |_, _| Some(Evaluated::new(
+            1.0,
+            ()
+        )))
+        .is_none()
+    );
+    // Densities that cannot be used: the candidate is ignored, whether a
+    // light candidate or the BSDF's (which also needs a positive BSDF
+    // density).
+    let densities = [
+        (1.0, f32::NAN),
+        (1.0, -1.0),
+        (1.0, f32::INFINITY),
+        (0.0, 1.0),
+        (f32::NAN, 1.0),
+        (-2.0, 1.0),
+    ];
+    for (pl, pb) in densities {
+        let e = Evaluated::new(1.0, ()).with_densities(pl, pb);
+        let light = resample(&s, &ctx, &cands, 0.5, None, |_, _| Some(e));
+        assert!(light.is_none(), "{pl} {pb}");
+        let found = resample(
+            &s,
+            &ctx,
+            &[],
+            0.5,
+            Some((LightId::Emitter(1), e)),
+            |_, _| None,
+        );
+        assert!(found.is_none(), "{pl} {pb}");
+    }
+    let no_bsdf_density = Evaluated::new(1.0, ()).with_densities(1.0, 0.0);
+    let found = resample(
+        &s,
+        &ctx,
+        &[],
+        0.5,
+        Some((LightId::Emitter(1), no_bsdf_density)),
+        |_, _| None,
+    );
+    assert!(found.is_none());
 }
 
 /// pbrt-v4 MIS with the candidate density as the proxy: the resampled
@@ -302,7 +342,7 @@ fn resampled_mis_is_unbiased() {
         // Light sample: uniform on the light (pdf 1).
         let ys: Vec<f32> = (0..cands.len()).map(|_| rng.f()).collect();
         let mut x = 0.0f64;
-        if let Some(r) = resample(&s, &ctx, &cands, rng.f(), |l, j| {
+        if let Some(r) = resample(&s, &ctx, &cands, rng.f(), None, |l, j| {
             let LightId::Emitter(k) = l else { return None };
             let y = k as f32 + ys[j];
             Some(Evaluated::new(radiance(k, y), (k, y)))
@@ -330,6 +370,90 @@ fn resampled_mis_is_unbiased() {
     assert!((mean - truth).abs() < 4.5 * se, "{mean} +- {se} vs {truth}");
 }
 
+/// The BSDF sample as one more candidate (balance-heuristic weights over
+/// the two strategies, no MIS weight, the emission it found counted only
+/// through the kept candidate): unbiased with 0, 1 and 4 light candidates,
+/// from a sampler that can choose every light and from one that cannot
+/// choose the last (only the BSDF sample finds it). The same line of four
+/// lights as above, the "BSDF" now sampling it with density `y / 8`. The
+/// control: light candidates that leave out the BSDF's density (the two
+/// strategies counted twice) are biased by far more than the noise.
+#[test]
+fn the_bsdf_sample_as_a_candidate_is_unbiased() {
+    let radiance = |k: u32, y: f32| (1.0 + k as f32) * (0.5 + (y - k as f32));
+    let visible = |k: u32, y: f32| !(k % 2 == 1 && y - (k as f32) < 0.5);
+    let truth: f64 = (0..400_000)
+        .map(|i| {
+            let y = 4.0 * (i as f32 + 0.5) / 400_000.0;
+            let k = (y as u32).min(3);
+            if visible(k, y) {
+                f64::from(radiance(k, y))
+            } else {
+                0.0
+            }
+        })
+        .sum::<f64>()
+        / 100_000.0;
+    let pdf_bsdf = |y: f32| y / 8.0;
+    let ctx = ShadingContext::at(Vec3::ZERO);
+    let run = |s: &dyn LightSampler, m: usize, densities: bool, seed: u64| {
+        let mut rng = Rand::new(seed);
+        let n = 200_000;
+        let (mut s1, mut s2) = (0.0f64, 0.0f64);
+        let mut cands = vec![0.0f32; m];
+        for _ in 0..n {
+            cands.iter_mut().for_each(|c| *c = rng.f());
+            let ys: Vec<f32> = (0..m).map(|_| rng.f()).collect();
+            // The BSDF sample: `y = 4 sqrt(u)` has density `y / 8`; its
+            // ray stops where the light is blocked.
+            let y = 4.0 * rng.f().sqrt();
+            let k = (y as u32).min(3);
+            let bsdf = visible(k, y).then(|| {
+                let e = Evaluated::new(radiance(k, y), (k, y)).with_densities(1.0, pdf_bsdf(y));
+                (LightId::Emitter(k), e)
+            });
+            let r = resample(s, &ctx, &cands, rng.f(), bsdf, |l, j| {
+                let LightId::Emitter(k) = l else { return None };
+                let y = k as f32 + ys[j];
+                let e = Evaluated::new(radiance(k, y), (k, y));
+                Some(if densities {
+                    e.with_densities(1.0, pdf_bsdf(y))
+                } else {
+                    e
+                })
+            });
+            let x = r.map_or(0.0, |r| {
+                let (k, y) = r.payload;
+                if r.bsdf || visible(k, y) {
+                    f64::from(radiance(k, y)) * f64::from(r.weight)
+                } else {
+                    0.0
+                }
+            });
+            s1 += x;
+            s2 += x * x;
+        }
+        let mean = s1 / n as f64;
+        (mean, ((s2 / n as f64 - mean * mean) / n as f64).sqrt())
+    };
+    let all = UniformSampler::new(4);
+    let three = UniformSampler::new(3);
+    for (name, s) in [("all", &all), ("three", &three)] {
+        for m in [0usize, 1, 4] {
+            let (mean, se) = run(s, m, true, 40 + m as u64);
+            assert!(
+                (mean - truth).abs() < 4.5 * se,
+                "{name}, M = {m}: {mean} +- {se} vs {truth}"
+            );
+        }
+    }
+    let (biased, se) = run(&all, 4, false, 99);
+    assert!(
+        (biased - truth).abs() > 10.0 * se,
+        "control: {biased} +- {se} vs {truth}"
+    );
+}
+
 /// The same numbers and evaluations give the same choice and weight.
 #[test]
 fn resampling_is_deterministic() {
@@ -346,8 +470,8 @@ fn resampling_is_deterministic() {
             let LightId::Emitter(e) = l else { return None };
             Some(Evaluated::new(unshadowed(&lights, e, p), e))
         };
-        let a = resample(&s, &ctx, &cands, u, eval).unwrap();
-        let b = resample(&s, &ctx, &cands, u, eval).unwrap();
+        let a = resample(&s, &ctx, &cands, u, None, eval).unwrap();
+        let b = resample(&s, &ctx, &cands, u, None, eval).unwrap();
         assert_eq!(a, b);
     }
 }

@@ -187,7 +187,7 @@ fn resampling_with_learned_visibility_is_unbiased_and_better() {
                 rng.f(),
                 rng.f(),
             ];
-            let x = resample(s, &ctx, &cands, rng.f(), |l, _| {
+            let x = resample(s, &ctx, &cands, rng.f(), None, |l, _| {
                 let LightId::Emitter(e) = l else { return None };
                 Some(Evaluated::new(unshadowed(&lights, e, p), e))
             })

@@ -78,8 +78,10 @@ pub struct Args {
     #[arg(long, default_value = "importance", value_parser = parse_prior)]
     pub prior: Prior,
     /// `pt-glt` and `ppg-glt` choose each NEE light by resampling this many
-    /// candidates of the GLT (`guiding::resampling`; at most 64); 0 or 1
-    /// sample the GLT directly (the default).
+    /// candidates of the GLT together with the light the path's next
+    /// direction finds (`guiding::resampling`; at most 64); 0 samples the
+    /// GLT directly and weighs the light the next direction finds by MIS
+    /// (the default).
     #[arg(long, default_value_t = 0)]
     pub resample: usize,
     /// The GLT's cuts learn each cluster's visibility from the NEE records

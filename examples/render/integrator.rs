@@ -6,6 +6,7 @@
 //! once a path is done, incident radiance into the SD-tree (or the field's
 //! quadtrees).
 
+use crate::bvh::Hit;
 use crate::geometry::{NO_EMITTER, offset_origin};
 use crate::lights::luminance;
 use crate::rng::Sampler;
@@ -13,7 +14,7 @@ use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 use guiding::field::{FieldVertex, GuidingField};
 use guiding::glt::Glt;
-use guiding::mis::{Convention, resampled_light_sample};
+use guiding::mis::Convention;
 use guiding::path_recorder::{RadianceRecords, Segment};
 use guiding::resampling::{Evaluated, resample};
 use guiding::sd_tree::{SdCell, SdTree};
@@ -83,6 +84,9 @@ struct Vertex<'a> {
     /// `f cos` of the direction sampled here (for contribution splats).
     f_cos: Vec3,
     delta: bool,
+    /// Resampled NEE here took the light the continuation found as a
+    /// candidate: that light's emission is not counted again.
+    resampled: bool,
 }
 
 /// Directional guiding at one vertex: an SD-tree cell or a field vertex.
@@ -205,11 +209,20 @@ pub fn radiance<'a>(
     let mut prev: Option<Vertex> = None;
     // True while every vertex so far was a delta (specular) one.
     let mut specular_chain = true;
+    // The continuation ray's hit when the last vertex traced it already
+    // (resampled NEE takes the light it finds as a candidate).
+    let mut traced: Option<Option<Hit>> = None;
     recorder.clear();
     for depth in 0..max_depth {
-        let Some(hit) = scene.intersect(origin, dir) else {
+        let hit = traced
+            .take()
+            .unwrap_or_else(|| scene.intersect(origin, dir));
+        // With resampling, the light the last vertex's direction found
+        // was one of its candidates: it counts only through that estimate.
+        let counted = prev.is_some_and(|v| v.resampled);
+        let Some(hit) = hit else {
             // The sky (the sun is a delta light: no BSDF sample finds it).
-            if let Some((id, sky)) = scene.sky() {
+            if let Some((id, sky)) = scene.sky().filter(|_| !counted) {
                 let pdf_light = |v: &Vertex| sky.pdf(v.normal, dir);
                 found_light(guides, prev, id, pdf_light, sky.radiance, recorder, s);
             }
@@ -220,7 +233,8 @@ pub fn radiance<'a>(
         let ng = prim.normal(p);
         // "Directly visible" includes through specular (delta) chains.
         let seen_by_camera = prev.is_none_or(|v| v.delta && specular_chain);
-        if prim.emitter != NO_EMITTER && (scene.camera_sees_emitters || !seen_by_camera) {
+        if prim.emitter != NO_EMITTER && !counted && (scene.camera_sees_emitters || !seen_by_camera)
+        {
             let light = &scene.lights[prim.emitter as usize];
             let le = light.emitted(dir, ng);
             if le.max_element() > 0.0 {
@@ -246,6 +260,7 @@ pub fn radiance<'a>(
                 pdf_dir: 0.0,
                 f_cos: Vec3::ONE,
                 delta: true,
+                resampled: false,
             });
             origin = offset_origin(p, ng, bs.wi);
             dir = bs.wi;
@@ -255,6 +270,7 @@ pub fn radiance<'a>(
         let n = if ng.dot(wo) < 0.0 { -ng } else { ng };
         let ctx = ShadingContext::on_surface(p, n);
         let field_vertex = guides.field.and_then(|f| f.vertex(p));
+        let resampled = guides.resample > 0;
         let here = Vertex {
             at: field_vertex,
             pos: p,
@@ -262,6 +278,7 @@ pub fn radiance<'a>(
             pdf_dir: 0.0,
             f_cos: Vec3::ONE,
             delta: false,
+            resampled,
         };
         let cell = match (field_vertex, guides.sd_tree) {
             (Some(v), _) => Some(DirGuide::Field(v)),
@@ -282,9 +299,31 @@ pub fn radiance<'a>(
             None => guides.lights,
         };
 
+        // The direction the path continues in: BSDF sampling, or PPG's
+        // mixture. Chosen first: resampled NEE takes the light it finds as
+        // a candidate.
+        let u_tech = s.next();
+        let (u2, u_lobe) = (s.next2(), s.next());
+        let continuation = if u_tech < frac || cell.is_none() {
+            mat.sample(n, wo, u2, u_lobe)
+                .map(|bs| (bs.wi, bs.weight * bs.pdf, bs.pdf))
+        } else {
+            cell.map(|c| {
+                let wi = c.sample([u2.x, u2.y]);
+                let (f, bsdf_pdf) = mat.eval(n, wo, wi);
+                (wi, f, bsdf_pdf)
+            })
+        }
+        .map(|(wi, f_cos, bsdf_pdf)| {
+            let (pdf, guide_pdf) = dir_pdf(wi, bsdf_pdf);
+            (wi, f_cos, bsdf_pdf, pdf, guide_pdf)
+        })
+        .filter(|c| c.3 > 0.0 && c.1.max_element() > 0.0);
+
         // Next-event estimation: one light from the sampler, or the one
-        // resampling keeps of several candidates (each with its light point
-        // and the weight that replaces 1 / pmf).
+        // resampling keeps of several candidates and the light the
+        // continuation found (each with its light point and the weight
+        // that replaces 1 / pmf).
         let point_on = |light: LightId, u: Vec2| match light {
             LightId::Emitter(e) => (scene.lights[e as usize].sample(p, u), false),
             LightId::Unbounded(i) => {
@@ -292,25 +331,43 @@ pub fn radiance<'a>(
                 (light.sample(n, u), light.is_delta())
             }
         };
-        let chosen = if guides.resample > 1 {
+        let chosen = if resampled {
             let m = guides.resample.min(MAX_CANDIDATES);
             let mut cands = [0.0f32; MAX_CANDIDATES];
             cands[..m].iter_mut().for_each(|c| *c = s.next());
             let u_keep = s.next();
-            resample(nee, &ctx, &cands[..m], u_keep, |light, _| {
+            // Trace the continuation now; the next vertex reuses the hit.
+            let found = continuation.and_then(|(wi, f_cos, _, pdf, _)| {
+                let next = scene.intersect(offset_origin(p, n, wi), wi);
+                traced = Some(next);
+                let (light, lp) = light_found(scene, p, n, wi, next)?;
+                let c = luminance(f_cos * lp.radiance) / lp.pdf;
+                Some((
+                    light,
+                    Evaluated::new(c, (lp, false)).with_densities(lp.pdf, pdf),
+                ))
+            });
+            resample(nee, &ctx, &cands[..m], u_keep, found, |light, _| {
                 let (lp, delta) = point_on(light, s.next2());
                 let lp = lp?;
-                let (f, _) = mat.eval(n, wo, lp.wi);
-                // The unshadowed estimate, `f cos Le / p_l`.
+                let (f, bsdf_pdf) = mat.eval(n, wo, lp.wi);
+                // The unshadowed estimate, `f cos Le / p_l`; the
+                // continuation's density of the direction (none for a
+                // delta light).
                 let c = luminance(f * lp.radiance) / lp.pdf;
-                Some(Evaluated::new(c, (lp, delta)))
+                let pdf = if delta {
+                    0.0
+                } else {
+                    dir_pdf(lp.wi, bsdf_pdf).0
+                };
+                Some(Evaluated::new(c, (lp, delta)).with_densities(lp.pdf, pdf))
             })
-            .map(|r| (r.light, r.pmf, Some(r.weight), Some(r.payload)))
+            .map(|r| (r.light, r.pmf, Some((r.weight, r.bsdf)), Some(r.payload)))
         } else {
             nee.sample(&ctx, s.next())
                 .map(|ls| (ls.light, ls.pmf, None, None))
         };
-        if let Some((light, pmf, weight, point)) = chosen {
+        if let Some((light, pmf, resampled, point)) = chosen {
             let (point, delta) = match point {
                 Some((lp, delta)) => (Some(lp), delta),
                 None => point_on(light, s.next2()),
@@ -325,26 +382,39 @@ pub fn radiance<'a>(
                     } else {
                         dir_pdf(lp.wi, bsdf_pdf).0
                     };
-                    let d = match weight {
-                        Some(w) => resampled_light_sample(ls.pmf, w, lp.pdf, p_dir),
-                        None => Convention::PbrtV4.light_sample(ls.pmf, lp.pdf, p_dir),
+                    // Resampled with the continuation: its weight is the
+                    // whole estimate's (no MIS weight); the light the
+                    // continuation found is visible.
+                    let (factor, known_visible) = match resampled {
+                        Some((w, from_bsdf)) => (w / lp.pdf, from_bsdf),
+                        None => (
+                            Convention::PbrtV4
+                                .light_sample(ls.pmf, lp.pdf, p_dir)
+                                .factor,
+                            false,
+                        ),
                     };
-                    let o = offset_origin(p, n, lp.wi);
-                    let target = match ls.light {
-                        LightId::Emitter(e) => e,
-                        LightId::Unbounded(_) => NO_EMITTER,
+                    let visible = known_visible || {
+                        let o = offset_origin(p, n, lp.wi);
+                        let target = match ls.light {
+                            LightId::Emitter(e) => e,
+                            LightId::Unbounded(_) => NO_EMITTER,
+                        };
+                        !scene.occluded(o, lp.wi, lp.dist, target)
                     };
-                    let visible = !scene.occluded(o, lp.wi, lp.dist, target);
-                    let c = f * lp.radiance * d.factor;
+                    let c = f * lp.radiance * factor;
                     if c.is_finite() {
-                        let value = splat_value(guides, f, lp.radiance) * d.factor;
+                        let value = splat_value(guides, f, lp.radiance) * factor;
                         if visible {
                             recorder.add_radiance(c);
                             if train_light {
                                 splat_light(guides, &here, ls.light, value, s);
                             }
                         }
-                        if train_light {
+                        // Visibility records come from light samples only
+                        // (the continuation's light is visible by
+                        // construction).
+                        if train_light && !known_visible {
                             let seen = if visible { value } else { 0.0 };
                             splat_visibility(guides, &here, ls.light, seen, value);
                         }
@@ -353,25 +423,10 @@ pub fn radiance<'a>(
             }
         }
 
-        // Continue the path: BSDF sampling, or PPG's mixture.
-        let u_tech = s.next();
-        let (u2, u_lobe) = (s.next2(), s.next());
-        let (wi, f_cos, bsdf_pdf) = if u_tech < frac || cell.is_none() {
-            let Some(bs) = mat.sample(n, wo, u2, u_lobe) else {
-                break;
-            };
-            (bs.wi, bs.weight * bs.pdf, bs.pdf)
-        } else {
-            let Some(c) = cell else { break };
-            let wi = c.sample([u2.x, u2.y]);
-            let (f, bsdf_pdf) = mat.eval(n, wo, wi);
-            (wi, f, bsdf_pdf)
-        };
-        let (pdf, guide_pdf) = dir_pdf(wi, bsdf_pdf);
-        if pdf.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || f_cos.max_element() <= 0.0
-        {
+        // Continue the path.
+        let Some((wi, f_cos, bsdf_pdf, pdf, guide_pdf)) = continuation else {
             break;
-        }
+        };
         let weight = f_cos / pdf;
         if train_sd {
             recorder.push_segment(field_vertex, p, wi, pdf, bsdf_pdf, guide_pdf, weight);
@@ -391,4 +446,48 @@ pub fn radiance<'a>(
     }
     let l = recorder.estimate();
     if l.is_finite() { l } else { Vec3::ZERO }
+}
+
+/// The light a ray from `p` (normal `n`) along `wi` reaches, `next` its
+/// hit: an emitter's point, or the sky when it escapes; as the light point
+/// light sampling would have given (its solid-angle pdf, the radiance
+/// arriving). `None` when it reaches no light or one that sends nothing
+/// this way.
+fn light_found(
+    scene: &Scene,
+    p: Vec3,
+    n: Vec3,
+    wi: Vec3,
+    next: Option<Hit>,
+) -> Option<(LightId, crate::lights::LightPoint)> {
+    let (light, lp) = match next {
+        Some(hit) => {
+            let prim = scene.primitive(&hit);
+            if prim.emitter == NO_EMITTER {
+                return None;
+            }
+            let light = &scene.lights[prim.emitter as usize];
+            let y = offset_origin(p, n, wi) + wi * hit.t;
+            let ny = prim.normal(y);
+            let dist = (y - p).length();
+            let lp = crate::lights::LightPoint {
+                wi,
+                dist,
+                pdf: light.pdf(p, wi, dist, ny),
+                radiance: light.emitted(wi, ny),
+            };
+            (LightId::Emitter(prim.emitter), lp)
+        }
+        None => {
+            let (id, sky) = scene.sky()?;
+            let lp = crate::lights::LightPoint {
+                wi,
+                dist: f32::INFINITY,
+                pdf: sky.pdf(n, wi),
+                radiance: sky.radiance,
+            };
+            (id, lp)
+        }
+    };
+    (lp.pdf > 0.0 && lp.pdf.is_finite() && lp.radiance.max_element() > 0.0).then_some((light, lp))
 }

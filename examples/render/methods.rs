@@ -112,7 +112,8 @@ pub struct GuideParams {
     /// Whether the cuts learn each cluster's visibility from the NEE
     /// records ([`CutConfig::visibility`]).
     pub visibility: bool,
-    /// Candidates of resampled NEE for the GLT methods (0 or 1: none).
+    /// Candidates of resampled NEE for the GLT methods, resampled with the
+    /// light the next direction finds (0: none, plain NEE with MIS).
     pub resample: usize,
 }
 
