@@ -815,7 +815,12 @@ fn memory_report_adds_up_and_compares_cuts_with_quadtrees() {
     );
     let ratio = m.cut_to_quadtree();
     assert_eq!(ratio, m.cut_bytes() as f64 / m.quadtree_bytes() as f64);
-    assert!(ratio > 0.0 && m.sampled_cut_to_quadtree() > 0.0);
+    assert!(ratio > 0.0);
+    // Cut nodes are 12 bytes, sampling quadtree nodes 24.
+    assert_eq!(
+        m.sampled_cut_to_quadtree(),
+        (12 * m.cuts.nodes) as f64 / (24 * m.sd.quadtree_nodes) as f64
+    );
     println!(
         "{} cells: cuts {} B ({} nodes) vs quadtrees {} B ({} sampling nodes): {:.2}x \
          (sampled copies {:.2}x); total {} B",
