@@ -49,4 +49,7 @@ fn crossing_is_where_the_guided_curve_stays_below() {
     assert_eq!(c.from, Some(0.5));
     let all = [record("ppg-glt s=0.05", &low, 10.0), record("ppg", &u, 1.0)];
     assert_eq!(crossings(&all).len(), 1);
+    // Without curves (`--no-curve`), or with one: no crossing, no panic.
+    assert!(crossing(&record("pt-glt", &[], 4.0), &record("pt-bvh", &[], 1.0)).is_none());
+    assert!(crossing(&record("pt-glt", &g, 4.0), &record("pt-bvh", &[], 1.0)).is_none());
 }

@@ -37,7 +37,8 @@ pub fn crossing(guided: &Record, unguided: &Record) -> Option<Crossing> {
     };
     let ((a0, a1), (b0, b1)) = (span(guided), span(unguided));
     let (lo, hi) = (a0.max(b0).ln(), a1.min(b1).ln());
-    if lo >= hi {
+    // Also without curves (`--no-curve`): then `hi` is NaN.
+    if lo.is_nan() || hi.is_nan() || lo >= hi {
         return None;
     }
     const STEPS: usize = 400;
