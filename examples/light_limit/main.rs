@@ -69,6 +69,17 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
+/// A resampling target's visibility factor.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Target {
+    /// None (visibility-blind).
+    Blind,
+    /// The GLT's learned visibility to this exponent.
+    Learned(f64),
+    /// The held-out visibility at the point.
+    Oracle,
+}
+
 /// Measures the exact per-sample variance of light selection against the
 /// clairvoyant pmf at shading points of the render example's scenes.
 #[derive(Parser, Debug)]
@@ -104,6 +115,12 @@ struct Args {
     /// visibility at the point (the best a learned visibility could do).
     #[arg(long, value_delimiter = ',')]
     resample: Vec<usize>,
+    /// Exponents of the learned visibility in the resampling target
+    /// (comma separated; the crate's `resample` takes 0.5: for a light
+    /// seen with probability `v`, `sqrt(v)` minimizes the variance of many
+    /// candidates).
+    #[arg(long, value_delimiter = ',', default_value = "0.5,1")]
+    visibility_exponent: Vec<f64>,
     /// BSDF samples per point.
     #[arg(long, default_value_t = 64)]
     bsdf_samples: usize,
@@ -322,31 +339,32 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
                 .collect();
             (ctx, pmfs)
         };
-        // Each light's visibility factor in the target of `kind` (below).
-        let visibility_of = |t: &PointTerms, ctx: &ShadingContext, kind: u8| -> Vec<f64> {
-            match kind {
-                1 | 3 => t
+        // Each light's visibility factor in a target (below).
+        let visibility_of = |t: &PointTerms, ctx: &ShadingContext, target: Target| -> Vec<f64> {
+            match target {
+                Target::Learned(e) => t
                     .lights
                     .iter()
-                    .map(|l| f64::from(glt.visibility(ctx, l.light)))
-                    .map(|v| if kind == 3 { v.sqrt() } else { v })
+                    .map(|l| f64::from(glt.visibility(ctx, l.light)).powf(e))
                     .collect(),
-                k => variance::visibilities(t, k == 2, 0.05),
+                k => variance::visibilities(t, k == Target::Oracle, 0.05),
             }
         };
-        // Targets: blind, the GLT's learned visibility (when it learns
-        // one), the visibility at the point (the best a learned one could
-        // do).
-        let targets: &[(&str, u8)] = if variant.params.visibility {
-            &[
-                ("unshadowed", 0),
-                ("x learned visibility", 1),
-                ("x sqrt of learned visibility", 3),
-                ("x visibility", 2),
-            ]
-        } else {
-            &[("unshadowed", 0), ("x visibility", 2)]
-        };
+        // Targets: blind, the GLT's learned visibility to each exponent
+        // (when it learns one; `resample` takes the square root), the
+        // visibility at the point (the best a learned one could do).
+        let mut targets = vec![("unshadowed".to_string(), Target::Blind)];
+        if variant.params.visibility {
+            for &e in &args.visibility_exponent {
+                let name = if e == 1.0 {
+                    "x learned visibility".to_string()
+                } else {
+                    format!("x learned visibility^{e}")
+                };
+                targets.push((name, Target::Learned(e)));
+            }
+        }
+        targets.push(("x visibility".to_string(), Target::Oracle));
         // Proxies of the MIS weights: the candidate density, and the
         // resampled density's approximation with the exact integral of the
         // target at the point (the bound of any proxy of that form; not for
@@ -360,8 +378,9 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
         ];
         for &m in &args.resample {
             for &(proxy, proxy_name) in &proxies {
-                for &(target, kind) in targets {
-                    if kind == 0 && proxy != variance::Proxy::Candidate {
+                for (target, kind) in &targets {
+                    let kind = *kind;
+                    if kind == Target::Blind && proxy != variance::Proxy::Candidate {
                         continue;
                     }
                     let v: Vec<f64> = points
@@ -381,8 +400,9 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
             // The BSDF sample resampled with the light candidates: one
             // sample, no MIS weights.
             for seen in [false, true] {
-                for &(target, kind) in targets {
-                    if seen && kind == 0 {
+                for (target, kind) in &targets {
+                    let kind = *kind;
+                    if seen && kind == Target::Blind {
                         continue;
                     }
                     let v: Vec<f64> = points
