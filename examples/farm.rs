@@ -141,6 +141,7 @@ fn render_passes(
         train,
         contribution_splats: false,
         resample: 0,
+        resample_vertices: 1,
     };
     let settings = settings(args);
     let len = (3 * args.width * args.height) as usize;

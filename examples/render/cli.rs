@@ -84,6 +84,11 @@ pub struct Args {
     /// (the default).
     #[arg(long, default_value_t = 0)]
     pub resample: usize,
+    /// Resample at the first this-many non-specular vertices of a path
+    /// (0: at every one); the others sample the GLT directly. The direct
+    /// light at the first vertex is what a pixel sees most of.
+    #[arg(long, default_value_t = 1)]
+    pub resample_vertices: u32,
     /// The GLT's cuts learn each cluster's visibility from the NEE records
     /// (`CutConfig::visibility`), the factor resampling puts on its target.
     #[arg(long)]

@@ -40,9 +40,12 @@ pub struct Guides<'a> {
     /// the paper's `Le w / p` (without the BSDF and cosine).
     pub contribution_splats: bool,
     /// Candidates of resampled next-event estimation
-    /// (`guiding::resampling`, at most [`MAX_CANDIDATES`]); 0 or 1 samples
-    /// the light sampler directly.
+    /// (`guiding::resampling`, at most [`MAX_CANDIDATES`]), resampled with
+    /// the light the continuation finds; 0 samples the light sampler
+    /// directly.
     pub resample: usize,
+    /// Resample at the first this-many non-specular vertices (0: all).
+    pub resample_vertices: u32,
 }
 
 /// The most candidates a resampled light choice draws.
@@ -212,6 +215,8 @@ pub fn radiance<'a>(
     // The continuation ray's hit when the last vertex traced it already
     // (resampled NEE takes the light it finds as a candidate).
     let mut traced: Option<Option<Hit>> = None;
+    // Non-specular vertices so far.
+    let mut scattered = 0u32;
     recorder.clear();
     for depth in 0..max_depth {
         let hit = traced
@@ -270,7 +275,9 @@ pub fn radiance<'a>(
         let n = if ng.dot(wo) < 0.0 { -ng } else { ng };
         let ctx = ShadingContext::on_surface(p, n);
         let field_vertex = guides.field.and_then(|f| f.vertex(p));
-        let resampled = guides.resample > 0;
+        let resampled = guides.resample > 0
+            && (guides.resample_vertices == 0 || scattered < guides.resample_vertices);
+        scattered += 1;
         let here = Vertex {
             at: field_vertex,
             pos: p,
@@ -293,10 +300,13 @@ pub fn radiance<'a>(
             }
             None => (bsdf_pdf, 0.0),
         };
-        // The field's vertex samples its cell's cut without a second lookup.
-        let nee: &dyn LightSampler = match &field_vertex {
-            Some(v) => v,
-            None => guides.lights,
+        // The field's (or the GLT's) vertex samples its cell's cut without
+        // a lookup per query.
+        let glt_vertex = guides.glt.and_then(|g| g.vertex(p));
+        let nee: &dyn LightSampler = match (&field_vertex, &glt_vertex) {
+            (Some(v), _) => v,
+            (None, Some(v)) => v,
+            (None, None) => guides.lights,
         };
 
         // The direction the path continues in: BSDF sampling, or PPG's

@@ -135,6 +135,7 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
         prior: args.prior,
         visibility: args.visibility,
         resample: args.resample,
+        resample_vertices: args.resample_vertices,
     };
     if args.paper_rules {
         params = params.paper_rules();

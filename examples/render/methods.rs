@@ -115,6 +115,8 @@ pub struct GuideParams {
     /// Candidates of resampled NEE for the GLT methods, resampled with the
     /// light the next direction finds (0: none, plain NEE with MIS).
     pub resample: usize,
+    /// Resample at the first this-many non-specular vertices (0: all).
+    pub resample_vertices: u32,
 }
 
 impl Default for GuideParams {
@@ -135,6 +137,7 @@ impl Default for GuideParams {
             prior: cut.prior,
             visibility: cut.visibility,
             resample: 0,
+            resample_vertices: 1,
         }
     }
 }

@@ -347,6 +347,7 @@ pub fn render_observed<'a>(
                 field: field.as_ref(),
                 train: trained && !it.is_last,
                 contribution_splats: settings.params.contribution_splats,
+                resample_vertices: settings.params.resample_vertices,
                 resample: if fixed.is_none() {
                     settings.params.resample
                 } else {
