@@ -81,6 +81,7 @@
 
 use crate::emitter::ShadingContext;
 use crate::light_sampler::{LightId, LightSampler};
+use crate::math::scalar::sqrt64;
 use crate::math::{Descent, Side};
 
 /// The light a resampled choice kept ([`resample`]), with what the renderer
@@ -276,7 +277,7 @@ impl<T> Reservoir<T> {
             if x > 0.0 && x.is_finite() { x } else { 1.0 }
         };
         // The square root of the learned visibility (module docs).
-        let target = c * valid(e.factor) * valid(learned).sqrt();
+        let target = c * valid(e.factor) * sqrt64(valid(learned));
         let pmf64 = if pmf > 0.0 && pmf.is_finite() {
             f64::from(pmf)
         } else {
