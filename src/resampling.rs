@@ -191,10 +191,10 @@ pub type BsdfCandidate<T> = (LightId, Evaluated<T>);
 /// contribution), and `u` keeps one in proportion to its weight (see the
 /// module docs), whose target is `contribution * factor` times the square
 /// root of the learned `sampler.visibility(ctx, light)` for light
-/// candidates (the BSDF candidate is visible). `bsdf` is the light the BSDF sample found, if it
-/// takes part and found one. `None` when no candidate contributes (then
-/// neither would the light sample: the estimate is 0) or there are no
-/// candidates.
+/// candidates (the BSDF candidate is visible). `bsdf` is the light the
+/// BSDF sample found, if it takes part and found one. `None` when no
+/// candidate contributes (then neither would the light sample: the
+/// estimate is 0) or there are no candidates.
 ///
 /// Deterministic: the same numbers and evaluations give the same choice.
 /// `evaluate` is called once per candidate the sampler draws, in order.
