@@ -278,30 +278,17 @@ fn bad_evaluations_are_ignored() {
         (f32::NAN, 1.0),
         (-2.0, 1.0),
     ];
-    for (pl, pb) in densities {
-        let e = Evaluated::new(1.0, ()).with_densities(pl, pb);
-        let light = resample(&s, &ctx, &cands, 0.5, None, |_, _| Some(e));
-        assert!(light.is_none(), "{pl} {pb}");
-        let found = resample(
-            &s,
-            &ctx,
-            &[],
-            0.5,
-            Some((LightId::Emitter(1), e)),
-            |_, _| None,
-        );
-        assert!(found.is_none(), "{pl} {pb}");
+    let evaluated = |(pl, pb): (f32, f32)| Evaluated::new(1.0, ()).with_densities(pl, pb);
+    for d in densities {
+        let light = resample(&s, &ctx, &cands, 0.5, None, |_, _| Some(evaluated(d)));
+        assert!(light.is_none(), "{d:?}");
     }
-    let no_bsdf_density = Evaluated::new(1.0, ()).with_densities(1.0, 0.0);
-    let found = resample(
-        &s,
-        &ctx,
-        &[],
-        0.5,
-        Some((LightId::Emitter(1), no_bsdf_density)),
-        |_, _| None,
-    );
-    assert!(found.is_none());
+    // A BSDF candidate without a BSDF density is ignored too.
+    for d in densities.into_iter().chain([(1.0, 0.0)]) {
+        let bsdf = Some((LightId::Emitter(1), evaluated(d)));
+        let found = resample(&s, &ctx, &[], 0.5, bsdf, |_, _| None);
+        assert!(found.is_none(), "{d:?}");
+    }
 }
 
 /// pbrt-v4 MIS with the candidate density as the proxy: the resampled

@@ -69,6 +69,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
+/// The variance at a point from its terms, its pmfs and its lights'
+/// visibility factors.
+type PointVariance<'a> = dyn Fn(&PointTerms, &[f64], &[f64]) -> f64 + Sync + 'a;
+
 /// A resampling target's visibility factor.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Target {
@@ -369,6 +373,17 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
         // resampled density's approximation with the exact integral of the
         // target at the point (the bound of any proxy of that form; not for
         // the blind target).
+        // `variance(point, pmfs, visibilities)` at every point, the
+        // visibilities those of `target`.
+        let per_point = |target: Target, variance: &PointVariance<'_>| -> Vec<f64> {
+            points
+                .par_iter()
+                .map(|t| {
+                    let (ctx, pmfs) = glt_pmfs(t);
+                    variance(t, &pmfs, &visibility_of(t, &ctx, target))
+                })
+                .collect()
+        };
         let proxies = [
             (variance::Proxy::Candidate, ""),
             (
@@ -383,16 +398,10 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
                     if kind == Target::Blind && proxy != variance::Proxy::Candidate {
                         continue;
                     }
-                    let v: Vec<f64> = points
-                        .par_iter()
-                        .map(|t| {
-                            let (ctx, pmfs) = glt_pmfs(t);
-                            let vis = visibility_of(t, &ctx, kind);
-                            let (nee, bsdf) =
-                                variance::resampled_parts_with(t, &pmfs, &vis, m, proxy);
-                            nee + bsdf
-                        })
-                        .collect();
+                    let v = per_point(kind, &|t, pmfs, vis| {
+                        let (nee, bsdf) = variance::resampled_parts_with(t, pmfs, vis, m, proxy);
+                        nee + bsdf
+                    });
                     let name = format!("{} resampled M={m} ({target}{proxy_name})", variant.name);
                     records.push(record(&name, &v, 0, variant.train_spp));
                 }
@@ -405,14 +414,9 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
                     if seen && kind == Target::Blind {
                         continue;
                     }
-                    let v: Vec<f64> = points
-                        .par_iter()
-                        .map(|t| {
-                            let (ctx, pmfs) = glt_pmfs(t);
-                            let vis = visibility_of(t, &ctx, kind);
-                            variance::bsdf_candidate_variance(t, &pmfs, &vis, m, seen)
-                        })
-                        .collect();
+                    let v = per_point(kind, &|t, pmfs, vis| {
+                        variance::bsdf_candidate_variance(t, pmfs, vis, m, seen)
+                    });
                     let name = format!(
                         "{} resampled M={m} + BSDF candidate ({target}{})",
                         variant.name,
