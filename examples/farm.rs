@@ -142,6 +142,7 @@ fn render_passes(
         contribution_splats: false,
         resample: 0,
         resample_vertices: 1,
+        nee_samples: 1,
     };
     let settings = settings(args);
     let len = (3 * args.width * args.height) as usize;

@@ -1424,3 +1424,59 @@ fn a_pmf_that_rounds_to_zero_is_never_sampled() {
         }
     }
 }
+
+/// What a cut reports of itself: the unbounded lights' fractions start at
+/// their prior shares and become `U_i / (U + T)` after a refine; its memory
+/// parts add up to its total, and adding memories adds every part.
+#[test]
+fn a_cut_reports_its_fractions_and_memory() {
+    let mut rng = Rand::new(5);
+    let lights = lights_in_box(&mut rng, 40, 4.0);
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let config = CutConfig {
+        min_splats: 0,
+        unbounded: UnboundedLights::new(2, 0.1).unwrap(),
+        ..CutConfig::default()
+    };
+    let guide = CutRules::new(&tree, config).unwrap();
+    let mut cut = guide.new_cut();
+    assert_eq!(cut.unbounded_fractions(), &[0.05f32, 0.05]);
+    // Emitters 1.0 in all, the first unbounded light 3.0, the second none.
+    for e in 0..40u32 {
+        guide.splat(&cut, LightId::Emitter(e), 1.0 / 40.0);
+    }
+    guide.splat(&cut, LightId::Unbounded(0), 3.0);
+    assert!(guide.refine(&mut cut));
+    let f = cut.unbounded_fractions();
+    assert_eq!(f.len(), 2);
+    assert!((f[0] - 0.75).abs() < 1e-6, "{f:?}");
+    assert_eq!(f[1], 0.0);
+
+    let m = cut.memory();
+    // (none of them 2, where doubling and squaring agree)
+    assert!(
+        [m.nodes, m.node_bytes, m.sum_bytes, m.inline_bytes]
+            .iter()
+            .all(|&x| x > 2),
+        "{m:?}"
+    );
+    assert!(m.nodes > 0 && m.node_bytes > 0 && m.sum_bytes > 0 && m.inline_bytes > 0);
+    assert_eq!(m.total(), m.node_bytes + m.sum_bytes + m.inline_bytes);
+    let mut twice = m;
+    twice += m;
+    assert_eq!(
+        (
+            twice.nodes,
+            twice.node_bytes,
+            twice.sum_bytes,
+            twice.inline_bytes
+        ),
+        (
+            2 * m.nodes,
+            2 * m.node_bytes,
+            2 * m.sum_bytes,
+            2 * m.inline_bytes
+        )
+    );
+    assert_eq!(twice.total(), 2 * m.total());
+}

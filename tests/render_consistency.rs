@@ -120,6 +120,7 @@ fn methods_agree_with(
             visibility: false,
             resample: 0,
             resample_vertices: 1,
+            nee_samples: 1,
         },
         seed: 1001,
         progress: false,
@@ -199,6 +200,17 @@ fn resampled_glt_methods_converge_to_the_same_image() {
     methods_agree_with("few-lights", 48, 36, 128, &glt, tweak);
 }
 
+/// Several light samples per vertex (`--nee-samples`, the instrument that
+/// measures what no light choice can remove), MIS counting them all: the
+/// same image, with and without a sun and a sky.
+#[test]
+fn several_light_samples_per_vertex_converge_to_the_same_image() {
+    let tweak = |p: &mut GuideParams| p.nee_samples = 4;
+    let methods = [Method::PtBvh, Method::PtGlt, Method::PpgGlt];
+    methods_agree_with("ring", 48, 36, 32, &methods, tweak);
+    methods_agree_with("few-lights", 48, 36, 64, &methods, tweak);
+}
+
 #[test]
 fn environment_every_method_converges_to_the_same_image() {
     methods_agree("few-lights", 48, 36, 128);
@@ -233,6 +245,7 @@ fn guided_methods_train_their_structures() {
             visibility: false,
             resample: 0,
             resample_vertices: 1,
+            nee_samples: 1,
         },
         seed: 5,
         progress: false,

@@ -89,6 +89,13 @@ pub struct Args {
     /// light at the first vertex is what a pixel sees most of.
     #[arg(long, default_value_t = 1)]
     pub resample_vertices: u32,
+    /// Light samples per vertex for next-event estimation, averaged (MIS
+    /// counts them all). Many of them approach a perfect light choice at
+    /// the vertices they are taken at, so what error remains is what no
+    /// light sampler can remove (an instrument, not a way to render;
+    /// exclusive with `--resample`).
+    #[arg(long, default_value_t = 1)]
+    pub nee_samples: u32,
     /// The GLT's cuts learn each cluster's visibility from the NEE records
     /// (`CutConfig::visibility`), the factor resampling puts on its target.
     #[arg(long)]

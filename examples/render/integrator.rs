@@ -46,6 +46,9 @@ pub struct Guides<'a> {
     pub resample: usize,
     /// Resample at the first this-many non-specular vertices (0: all).
     pub resample_vertices: u32,
+    /// Light samples per vertex without resampling (at least 1), averaged;
+    /// MIS weighs the light strategy as this many samples.
+    pub nee_samples: u32,
 }
 
 /// The most candidates a resampled light choice draws.
@@ -184,9 +187,11 @@ fn found_light(
         recorder.add_radiance(le);
         return;
     };
+    // The light strategy took `nee_samples` samples at `v`.
     let pmf = guides
         .lights
-        .pmf(&ShadingContext::on_surface(v.pos, v.normal), id);
+        .pmf(&ShadingContext::on_surface(v.pos, v.normal), id)
+        * guides.nee_samples as f32;
     let d = Convention::PbrtV4.bsdf_sample(pmf, pdf_light(&v), v.pdf_dir);
     recorder.add_radiance(le * d.weight);
     let train = guides.train && (guides.glt.is_some() || guides.field.is_some());
@@ -341,92 +346,98 @@ pub fn radiance<'a>(
                 (light.sample(n, u), light.is_delta())
             }
         };
-        let chosen = if resampled {
-            let m = guides.resample.min(MAX_CANDIDATES);
-            let mut cands = [0.0f32; MAX_CANDIDATES];
-            cands[..m].iter_mut().for_each(|c| *c = s.next());
-            let u_keep = s.next();
-            // Trace the continuation now; the next vertex reuses the hit.
-            let found = continuation.and_then(|(wi, f_cos, _, pdf, _)| {
-                let next = scene.intersect(offset_origin(p, n, wi), wi);
-                traced = Some(next);
-                let (light, lp) = light_found(scene, p, n, wi, next)?;
-                let c = luminance(f_cos * lp.radiance) / lp.pdf;
-                Some((
-                    light,
-                    Evaluated::new(c, (lp, false)).with_densities(lp.pdf, pdf),
-                ))
-            });
-            resample(nee, &ctx, &cands[..m], u_keep, found, |light, _| {
-                let (lp, delta) = point_on(light, s.next2());
-                let lp = lp?;
-                let (f, bsdf_pdf) = mat.eval(n, wo, lp.wi);
-                // The unshadowed estimate, `f cos Le / p_l`; the
-                // continuation's density of the direction (none for a
-                // delta light).
-                let c = luminance(f * lp.radiance) / lp.pdf;
-                let pdf = if delta {
-                    0.0
-                } else {
-                    dir_pdf(lp.wi, bsdf_pdf).0
-                };
-                Some(Evaluated::new(c, (lp, delta)).with_densities(lp.pdf, pdf))
-            })
-            .map(|r| (r.light, r.pmf, Some((r.weight, r.bsdf)), Some(r.payload)))
-        } else {
-            nee.sample(&ctx, s.next())
-                .map(|ls| (ls.light, ls.pmf, None, None))
-        };
-        if let Some((light, pmf, resampled, point)) = chosen {
-            let (point, delta) = match point {
-                Some((lp, delta)) => (Some(lp), delta),
-                None => point_on(light, s.next2()),
-            };
-            let ls = guiding::LightSample { light, pmf };
-            if let Some(lp) = point {
-                let (f, bsdf_pdf) = mat.eval(n, wo, lp.wi);
-                if f.max_element() > 0.0 && lp.pdf > 0.0 && lp.radiance.max_element() > 0.0 {
-                    // A delta light has no competing BSDF sample.
-                    let p_dir = if delta {
+        // Without resampling, `nee_samples` light samples share the
+        // estimate (MIS counts the light strategy's density that many
+        // times).
+        let draws = if resampled { 1 } else { guides.nee_samples };
+        for _ in 0..draws {
+            let chosen = if resampled {
+                let m = guides.resample.min(MAX_CANDIDATES);
+                let mut cands = [0.0f32; MAX_CANDIDATES];
+                cands[..m].iter_mut().for_each(|c| *c = s.next());
+                let u_keep = s.next();
+                // Trace the continuation now; the next vertex reuses the hit.
+                let found = continuation.and_then(|(wi, f_cos, _, pdf, _)| {
+                    let next = scene.intersect(offset_origin(p, n, wi), wi);
+                    traced = Some(next);
+                    let (light, lp) = light_found(scene, p, n, wi, next)?;
+                    let c = luminance(f_cos * lp.radiance) / lp.pdf;
+                    Some((
+                        light,
+                        Evaluated::new(c, (lp, false)).with_densities(lp.pdf, pdf),
+                    ))
+                });
+                resample(nee, &ctx, &cands[..m], u_keep, found, |light, _| {
+                    let (lp, delta) = point_on(light, s.next2());
+                    let lp = lp?;
+                    let (f, bsdf_pdf) = mat.eval(n, wo, lp.wi);
+                    // The unshadowed estimate, `f cos Le / p_l`; the
+                    // continuation's density of the direction (none for a
+                    // delta light).
+                    let c = luminance(f * lp.radiance) / lp.pdf;
+                    let pdf = if delta {
                         0.0
                     } else {
                         dir_pdf(lp.wi, bsdf_pdf).0
                     };
-                    // Resampled with the continuation: its weight is the
-                    // whole estimate's (no MIS weight); the light the
-                    // continuation found is visible.
-                    let (factor, known_visible) = match resampled {
-                        Some((w, from_bsdf)) => (w / lp.pdf, from_bsdf),
-                        None => (
-                            Convention::PbrtV4
-                                .light_sample(ls.pmf, lp.pdf, p_dir)
-                                .factor,
-                            false,
-                        ),
-                    };
-                    let visible = known_visible || {
-                        let o = offset_origin(p, n, lp.wi);
-                        let target = match ls.light {
-                            LightId::Emitter(e) => e,
-                            LightId::Unbounded(_) => NO_EMITTER,
+                    Some(Evaluated::new(c, (lp, delta)).with_densities(lp.pdf, pdf))
+                })
+                .map(|r| (r.light, r.pmf, Some((r.weight, r.bsdf)), Some(r.payload)))
+            } else {
+                nee.sample(&ctx, s.next())
+                    .map(|ls| (ls.light, ls.pmf * draws as f32, None, None))
+            };
+            if let Some((light, pmf, resampled, point)) = chosen {
+                let (point, delta) = match point {
+                    Some((lp, delta)) => (Some(lp), delta),
+                    None => point_on(light, s.next2()),
+                };
+                let ls = guiding::LightSample { light, pmf };
+                if let Some(lp) = point {
+                    let (f, bsdf_pdf) = mat.eval(n, wo, lp.wi);
+                    if f.max_element() > 0.0 && lp.pdf > 0.0 && lp.radiance.max_element() > 0.0 {
+                        // A delta light has no competing BSDF sample.
+                        let p_dir = if delta {
+                            0.0
+                        } else {
+                            dir_pdf(lp.wi, bsdf_pdf).0
                         };
-                        !scene.occluded(o, lp.wi, lp.dist, target)
-                    };
-                    let c = f * lp.radiance * factor;
-                    if c.is_finite() {
-                        let value = splat_value(guides, f, lp.radiance) * factor;
-                        if visible {
-                            recorder.add_radiance(c);
-                            if train_light {
-                                splat_light(guides, &here, ls.light, value, s);
+                        // Resampled with the continuation: its weight is the
+                        // whole estimate's (no MIS weight); the light the
+                        // continuation found is visible.
+                        let (factor, known_visible) = match resampled {
+                            Some((w, from_bsdf)) => (w / lp.pdf, from_bsdf),
+                            None => (
+                                Convention::PbrtV4
+                                    .light_sample(ls.pmf, lp.pdf, p_dir)
+                                    .factor,
+                                false,
+                            ),
+                        };
+                        let visible = known_visible || {
+                            let o = offset_origin(p, n, lp.wi);
+                            let target = match ls.light {
+                                LightId::Emitter(e) => e,
+                                LightId::Unbounded(_) => NO_EMITTER,
+                            };
+                            !scene.occluded(o, lp.wi, lp.dist, target)
+                        };
+                        let c = f * lp.radiance * factor;
+                        if c.is_finite() {
+                            let value = splat_value(guides, f, lp.radiance) * factor;
+                            if visible {
+                                recorder.add_radiance(c);
+                                if train_light {
+                                    splat_light(guides, &here, ls.light, value, s);
+                                }
                             }
-                        }
-                        // Visibility records come from light samples only
-                        // (the continuation's light is visible by
-                        // construction).
-                        if train_light && !known_visible {
-                            let seen = if visible { value } else { 0.0 };
-                            splat_visibility(guides, &here, ls.light, seen, value);
+                            // Visibility records come from light samples only
+                            // (the continuation's light is visible by
+                            // construction).
+                            if train_light && !known_visible {
+                                let seen = if visible { value } else { 0.0 };
+                                splat_visibility(guides, &here, ls.light, seen, value);
+                            }
                         }
                     }
                 }

@@ -99,6 +99,9 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
             .map_err(|e| e.to_string())?;
     }
     let (scene_names, methods) = selection(args)?;
+    if args.nee_samples == 0 || (args.nee_samples > 1 && args.resample > 0) {
+        return Err("--nee-samples takes at least 1, and only without --resample".into());
+    }
     let reference_method = Method::parse(&args.reference_method)
         .ok_or_else(|| format!("unknown reference method {:?}", args.reference_method))?;
     let budget = match (args.spp, args.seconds) {
@@ -136,6 +139,7 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
         visibility: args.visibility,
         resample: args.resample,
         resample_vertices: args.resample_vertices,
+        nee_samples: args.nee_samples,
     };
     if args.paper_rules {
         params = params.paper_rules();

@@ -117,6 +117,8 @@ pub struct GuideParams {
     pub resample: usize,
     /// Resample at the first this-many non-specular vertices (0: all).
     pub resample_vertices: u32,
+    /// Light samples per vertex (without resampling), averaged.
+    pub nee_samples: u32,
 }
 
 impl Default for GuideParams {
@@ -138,6 +140,7 @@ impl Default for GuideParams {
             visibility: cut.visibility,
             resample: 0,
             resample_vertices: 1,
+            nee_samples: 1,
         }
     }
 }

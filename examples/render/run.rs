@@ -348,6 +348,7 @@ pub fn render_observed<'a>(
                 train: trained && !it.is_last,
                 contribution_splats: settings.params.contribution_splats,
                 resample_vertices: settings.params.resample_vertices,
+                nee_samples: settings.params.nee_samples.max(1),
                 resample: if fixed.is_none() {
                     settings.params.resample
                 } else {
