@@ -143,6 +143,7 @@ fn render_passes(
         resample: 0,
         resample_vertices: 1,
         nee_samples: 1,
+        nee_samples_vertices: 0,
     };
     let settings = settings(args);
     let len = (3 * args.width * args.height) as usize;

@@ -96,6 +96,10 @@ pub struct Args {
     /// exclusive with `--resample`).
     #[arg(long, default_value_t = 1)]
     pub nee_samples: u32,
+    /// Take `--nee-samples` at the first this-many non-specular vertices of
+    /// a path (0: at every one); the others take one.
+    #[arg(long, default_value_t = 0)]
+    pub nee_samples_vertices: u32,
     /// The GLT's cuts learn each cluster's visibility from the NEE records
     /// (`CutConfig::visibility`), the factor resampling puts on its target.
     #[arg(long)]

@@ -49,6 +49,9 @@ pub struct Guides<'a> {
     /// Light samples per vertex without resampling (at least 1), averaged;
     /// MIS weighs the light strategy as this many samples.
     pub nee_samples: u32,
+    /// Take `nee_samples` at the first this-many non-specular vertices (0:
+    /// all); the others take one.
+    pub nee_samples_vertices: u32,
 }
 
 /// The most candidates a resampled light choice draws.
@@ -93,6 +96,8 @@ struct Vertex<'a> {
     /// Resampled NEE here took the light the continuation found as a
     /// candidate: that light's emission is not counted again.
     resampled: bool,
+    /// Light samples next-event estimation took here (MIS counts them).
+    nee: u32,
 }
 
 /// Directional guiding at one vertex: an SD-tree cell or a field vertex.
@@ -187,11 +192,11 @@ fn found_light(
         recorder.add_radiance(le);
         return;
     };
-    // The light strategy took `nee_samples` samples at `v`.
+    // The light strategy took `v.nee` samples at `v`.
     let pmf = guides
         .lights
         .pmf(&ShadingContext::on_surface(v.pos, v.normal), id)
-        * guides.nee_samples as f32;
+        * v.nee as f32;
     let d = Convention::PbrtV4.bsdf_sample(pmf, pdf_light(&v), v.pdf_dir);
     recorder.add_radiance(le * d.weight);
     let train = guides.train && (guides.glt.is_some() || guides.field.is_some());
@@ -271,6 +276,7 @@ pub fn radiance<'a>(
                 f_cos: Vec3::ONE,
                 delta: true,
                 resampled: false,
+                nee: 1,
             });
             origin = offset_origin(p, ng, bs.wi);
             dir = bs.wi;
@@ -282,6 +288,13 @@ pub fn radiance<'a>(
         let field_vertex = guides.field.and_then(|f| f.vertex(p));
         let resampled = guides.resample > 0
             && (guides.resample_vertices == 0 || scattered < guides.resample_vertices);
+        let draws = if resampled
+            || (guides.nee_samples_vertices > 0 && scattered >= guides.nee_samples_vertices)
+        {
+            1
+        } else {
+            guides.nee_samples
+        };
         scattered += 1;
         let here = Vertex {
             at: field_vertex,
@@ -291,6 +304,7 @@ pub fn radiance<'a>(
             f_cos: Vec3::ONE,
             delta: false,
             resampled,
+            nee: draws,
         };
         let cell = match (field_vertex, guides.sd_tree) {
             (Some(v), _) => Some(DirGuide::Field(v)),
@@ -349,7 +363,6 @@ pub fn radiance<'a>(
         // Without resampling, `nee_samples` light samples share the
         // estimate (MIS counts the light strategy's density that many
         // times).
-        let draws = if resampled { 1 } else { guides.nee_samples };
         for _ in 0..draws {
             let chosen = if resampled {
                 let m = guides.resample.min(MAX_CANDIDATES);

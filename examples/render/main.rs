@@ -140,6 +140,7 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
         resample: args.resample,
         resample_vertices: args.resample_vertices,
         nee_samples: args.nee_samples,
+        nee_samples_vertices: args.nee_samples_vertices,
     };
     if args.paper_rules {
         params = params.paper_rules();

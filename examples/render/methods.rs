@@ -119,6 +119,9 @@ pub struct GuideParams {
     pub resample_vertices: u32,
     /// Light samples per vertex (without resampling), averaged.
     pub nee_samples: u32,
+    /// Take `nee_samples` at the first this-many non-specular vertices
+    /// (0: all).
+    pub nee_samples_vertices: u32,
 }
 
 impl Default for GuideParams {
@@ -141,6 +144,7 @@ impl Default for GuideParams {
             resample: 0,
             resample_vertices: 1,
             nee_samples: 1,
+            nee_samples_vertices: 0,
         }
     }
 }

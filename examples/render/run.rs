@@ -349,6 +349,7 @@ pub fn render_observed<'a>(
                 contribution_splats: settings.params.contribution_splats,
                 resample_vertices: settings.params.resample_vertices,
                 nee_samples: settings.params.nee_samples.max(1),
+                nee_samples_vertices: settings.params.nee_samples_vertices,
                 resample: if fixed.is_none() {
                     settings.params.resample
                 } else {
