@@ -379,3 +379,70 @@ pub(super) fn visibility_slots(nodes: usize, config: &CutConfig) -> usize {
 pub(super) fn sum_count(nodes: usize, unbounded: u32) -> usize {
     (2 * nodes).max(1) + unbounded as usize
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emitter::Emitter;
+    use crate::light_tree::{BuildHeuristic, LightTree};
+
+    /// `check` names each way a cut can be broken, at the node that breaks
+    /// it.
+    #[test]
+    fn check_names_each_broken_cut() {
+        let two = vec![
+            Emitter::point(Vec3::ZERO, 1.0),
+            Emitter::point(Vec3::X, 2.0),
+        ];
+        let tree = LightTree::build(&two, BuildHeuristic::Sarh).unwrap();
+        let config = CutConfig::default();
+        let [l, r] = tree.children(tree.root().unwrap()).unwrap();
+        let cut = |nodes: Vec<CutNode>| {
+            let mut c = GuidingCut::new(&tree, &config);
+            c.sums = SumBuffer::new(sum_count(nodes.len(), 0), config.accumulation);
+            c.nodes = nodes;
+            c
+        };
+        let node = |p: f32, a: Slot, b: Slot| CutNode::new(p, [a, b]);
+        let ends = node(0.5, Slot::End(l), Slot::End(r));
+        assert_eq!(GuidingCut::new(&tree, &config).check(&tree), Ok(()));
+        assert_eq!(cut(vec![ends]).check(&tree), Ok(()));
+        let broken = [
+            (
+                vec![node(0.5, Slot::End(r), Slot::End(l))],
+                CutError::WrongEnd { node: 0 },
+            ),
+            (
+                vec![node(1.5, Slot::End(l), Slot::End(r))],
+                CutError::BadProbability { node: 0 },
+            ),
+            (
+                vec![node(f32::NAN, Slot::End(l), Slot::End(r))],
+                CutError::BadProbability { node: 0 },
+            ),
+            (
+                vec![node(0.5, Slot::Child(3), Slot::End(r))],
+                CutError::IndexOutOfRange { node: 0 },
+            ),
+            (
+                vec![node(0.5, Slot::Child(0), Slot::End(r))],
+                CutError::NotPreOrder { node: 0 },
+            ),
+            (vec![ends, ends], CutError::Unreachable { node: 1 }),
+            // The left child is a leaf: a cut node cannot stand for it.
+            (
+                vec![node(0.5, Slot::Child(1), Slot::End(r)), ends],
+                CutError::NotInner { node: 1 },
+            ),
+        ];
+        for (nodes, want) in broken {
+            assert_eq!(cut(nodes).check(&tree), Err(want));
+        }
+        let mut short = cut(vec![ends]);
+        short.sums = SumBuffer::new(1, config.accumulation);
+        assert_eq!(short.check(&tree), Err(CutError::SumCount));
+        let none: Vec<Emitter> = Vec::new();
+        let empty = LightTree::build(&none, BuildHeuristic::Sarh).unwrap();
+        assert_eq!(cut(vec![ends]).check(&empty), Err(CutError::NoTree));
+    }
+}
