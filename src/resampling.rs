@@ -212,13 +212,12 @@ where
     let m = candidates.len() as f64;
     let mut reservoir = Reservoir::new(u);
     for (j, &uj) in candidates.iter().enumerate() {
-        let Some(x) = sampler.sample(ctx, uj) else {
+        let Some((x, learned)) = sampler.sample_with_visibility(ctx, uj) else {
             continue;
         };
         let Some(e) = evaluate(x.light, j) else {
             continue;
         };
-        let learned = sampler.visibility(ctx, x.light);
         reservoir.offer(x.light, x.pmf, m, learned, e, false);
     }
     if let Some((light, e)) = bsdf.filter(|(_, e)| e.pdf_bsdf > 0.0) {

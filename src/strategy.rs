@@ -137,4 +137,8 @@ impl LightSampler for Strategy {
     fn visibility(&self, ctx: &ShadingContext, light: LightId) -> f32 {
         inner!(self, s => s.visibility(ctx, light))
     }
+
+    fn sample_with_visibility(&self, ctx: &ShadingContext, u: f32) -> Option<(LightSample, f32)> {
+        inner!(self, s => s.sample_with_visibility(ctx, u))
+    }
 }

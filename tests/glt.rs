@@ -1382,6 +1382,14 @@ fn a_cut_as_a_light_sampler_answers_as_its_rules() {
         assert_eq!(s.pmf_exact(&ctx, l), guide.pmf_exact(&cut, &ctx, l));
         assert_eq!(s.visibility(&ctx, l), guide.visibility(&cut, l));
         assert!(s.visibility(&ctx, l) < 0.5, "learned from 1/4 records");
+        let with = guide.sample_with_visibility(&cut, &ctx, u);
+        assert_eq!(s.sample_with_visibility(&ctx, u), with);
+        assert_eq!(
+            with,
+            guide
+                .sample(&cut, &ctx, u)
+                .map(|x| (x, guide.visibility(&cut, x.light)))
+        );
     }
     // Lights without power and no unbounded light: empty, and says so.
     let dark: Vec<Emitter> = lights

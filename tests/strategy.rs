@@ -36,6 +36,11 @@ fn each_name_is_its_sampler() {
             let u = rng.f();
             let x = s.sample(&ctx, u);
             assert_eq!(x, reference.sample(&ctx, u), "{name}");
+            assert_eq!(
+                s.sample_with_visibility(&ctx, u),
+                reference.sample_with_visibility(&ctx, u),
+                "{name}"
+            );
             let x = x.unwrap();
             assert_eq!(s.pmf(&ctx, x.light), x.pmf, "{name}");
         }

@@ -191,6 +191,20 @@ fn field_vertex_equals_the_field_by_position() {
         }
         let u = rng.f64();
         assert_eq!(by_pos.sample_exact(&ctx, u), v.sample_exact(&ctx, u));
+        // Sampling with the visibility read on the way equals sampling,
+        // then asking the visibility, through either.
+        let u = u as f32;
+        let samplers: [&dyn LightSampler; 2] = [&by_pos, &v];
+        for s in samplers {
+            let want = s
+                .sample(&ctx, u)
+                .map(|x| (x, s.visibility(&ctx, x.light).to_bits()));
+            let got = s
+                .sample_with_visibility(&ctx, u)
+                .map(|(x, vis)| (x, vis.to_bits()));
+            assert!(want.is_some());
+            assert_eq!(got, want);
+        }
     }
     assert!(learned > 0, "no visibility learned");
     assert!(by_pos.locate(Vec3::NAN).is_none());

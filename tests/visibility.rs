@@ -207,3 +207,63 @@ fn resampling_with_learned_visibility_is_unbiased_and_better() {
     assert!((m0 - truth).abs() < 4.5 * se0, "{m0} +- {se0} vs {truth}");
     assert!(v1 < 0.8 * v0, "learned visibility {v1}, blind {v0}");
 }
+
+/// `sample_with_visibility` (the visibility read where the walk leaves the
+/// cut) answers exactly as `sample` and then `visibility` (the light's
+/// path walked again), for the GLT, its vertex and one cell's cut as a
+/// sampler, with and without a sun and a sky whose visibility is learned
+/// too. Control: reading the other side's slot differs on most draws.
+#[test]
+fn sampling_with_visibility_equals_sampling_then_visibility() {
+    let lights = two_rooms();
+    for unbounded in [
+        guiding::UnboundedLights::NONE,
+        guiding::UnboundedLights::new(2, 0.2).unwrap(),
+    ] {
+        let mut cfg = config(true);
+        cfg.cut.unbounded = unbounded;
+        let mut glt = Glt::new(tree(), scene(), cfg).unwrap();
+        let mut rng = Rand::new(77);
+        for _ in 0..3 {
+            for _ in 0..8000 {
+                let p = rng.point(9.5);
+                let Some(x) = glt.sample(&ShadingContext::at(p), rng.f()) else {
+                    continue;
+                };
+                let (seen, open) = match x.light {
+                    LightId::Emitter(e) => (value(&lights, e, p), unshadowed(&lights, e, p)),
+                    // The first unbounded light is hidden half the time.
+                    LightId::Unbounded(i) => (if i == 0 && rng.f() < 0.5 { 0.0 } else { 1.0 }, 1.0),
+                };
+                glt.splat_at(p, x.light, seen / x.pmf);
+                glt.splat_visibility(p, x.light, seen / x.pmf, open / x.pmf);
+            }
+            glt.refine();
+        }
+        let (mut draws, mut learned) = (0, 0);
+        for _ in 0..3000 {
+            let p = rng.point(9.5);
+            let ctx = ShadingContext::on_surface(p, Vec3::Y);
+            let u = rng.f();
+            let vertex = glt.vertex(p).unwrap();
+            let samplers: [&dyn LightSampler; 2] = [&glt, &vertex];
+            for s in samplers {
+                let want = s.sample(&ctx, u).map(|x| (x, s.visibility(&ctx, x.light)));
+                let got = s.sample_with_visibility(&ctx, u);
+                assert_eq!(
+                    got.map(|(x, v)| (x, v.to_bits())),
+                    want.map(|(x, v)| (x, v.to_bits())),
+                    "at {p} with u = {u}"
+                );
+                draws += usize::from(got.is_some());
+                learned += usize::from(got.is_some_and(|(_, v)| v < 0.99));
+            }
+        }
+        // The check has something to see: most draws answer, and many of
+        // them with a visibility learned below 1.
+        assert!(
+            draws > 5000 && learned > 100,
+            "{draws} draws, {learned} learned"
+        );
+    }
+}

@@ -304,4 +304,10 @@ impl<H: LightHierarchy> LightSampler for GuidingField<H> {
         self.cell_at(ctx.position)
             .map_or(1.0, |cell| self.guide.visibility(&cell.cut, light))
     }
+
+    /// One lookup and one walk.
+    fn sample_with_visibility(&self, ctx: &ShadingContext, u: f32) -> Option<(LightSample, f32)> {
+        let cell = self.cell_at(ctx.position)?;
+        self.guide.sample_with_visibility(&cell.cut, ctx, u)
+    }
 }

@@ -188,4 +188,12 @@ impl<H: LightHierarchy> LightSampler for FieldVertex<'_, H> {
     fn visibility(&self, _ctx: &ShadingContext, light: LightId) -> f32 {
         self.field.guide.visibility(&self.cell.cut, light)
     }
+
+    /// One walk: the visibility is read where it leaves the cut.
+    #[inline]
+    fn sample_with_visibility(&self, ctx: &ShadingContext, u: f32) -> Option<(LightSample, f32)> {
+        self.field
+            .guide
+            .sample_with_visibility(&self.cell.cut, ctx, u)
+    }
 }

@@ -319,8 +319,16 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
         }
     }
 
-    /// Samples a light with the descent `d`; the light and its `f64` pmf.
-    pub(crate) fn sample(&self, mut d: Descent) -> Option<(LightId, f64)> {
+    /// Samples a light with the descent `d`; the light, its `f64` pmf and
+    /// the index of its sum in the cut (the slot where the walk left the
+    /// cut, or its unbounded light's: [`CutRules::sum_of`] of the light,
+    /// found without a second walk) when `SUM` (else 0: the walk that does
+    /// not need it does not track it).
+    pub(crate) fn sample<const SUM: bool>(
+        &self,
+        mut d: Descent,
+        sum: &mut usize,
+    ) -> Option<(LightId, f64)> {
         let m = self.mixture;
         if m.unbounded > 0.0 {
             let (pu, pe) = Descent::probabilities(m.unbounded, m.cut + m.prior)?;
@@ -328,6 +336,9 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
                 let f = self.unbounded;
                 let weight = |i: u32| m.unbounded_pmf(f[i as usize]);
                 let i = choose_unbounded(&mut d, f.len() as u32, weight)?;
+                if SUM {
+                    *sum = (2 * self.nodes.len()).max(1) + i as usize;
+                }
                 return Some((LightId::Unbounded(i), weight(i)));
             }
         }
@@ -347,6 +358,12 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
         };
         let walk = self.guide.walk();
         let mut children = at.node.children().map(|k| walk.pair(k));
+        // The cut node the walk is in, and the slot it left the cut by
+        // (the root's only slot when the cut has no nodes).
+        let mut in_cut = at.cut.filter(|_| SUM).map(|_| 0u32);
+        if SUM {
+            *sum = 0;
+        }
         while let Some(pair) = children {
             // Load the next level for both sides before choosing: these
             // loads do not depend on `u`, so they overlap with this level's
@@ -358,6 +375,12 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
             let side = d.choose_with(pl, pr);
             self.apply(&mut p, &step, side);
             let k = side.index();
+            if let Some(i) = in_cut.filter(|_| SUM) {
+                in_cut = step.next[k];
+                if in_cut.is_none() {
+                    *sum = 2 * i as usize + k;
+                }
+            }
             at = Cursor {
                 node: pair.0[k],
                 cut: cuts[k],
@@ -441,6 +464,25 @@ impl<H: LightHierarchy> CutRules<H> {
         to_light_sample(self.sample_exact_from(cut, ctx, Descent::new(u)))
     }
 
+    /// [`CutRules::sample`] and the chosen light's learned
+    /// [`CutRules::visibility`] in `cut`, read where the walk leaves the
+    /// cut instead of walking the light's path again.
+    #[inline]
+    pub fn sample_with_visibility(
+        &self,
+        cut: &GuidingCut,
+        ctx: &ShadingContext,
+        u: f32,
+    ) -> Option<(LightSample, f32)> {
+        if !ctx.is_finite() {
+            return None;
+        }
+        let mut sum = 0;
+        let s =
+            to_light_sample(Rule::new(self, cut, ctx).sample::<true>(Descent::new(u), &mut sum))?;
+        Some((s, self.visibility_at(cut, Some(sum))))
+    }
+
     /// Like [`CutRules::sample`] from an `f64` number (53 bits),
     /// returning the unrounded `f64` pmf: equal, bit for bit, to
     /// [`CutRules::pmf_exact`] for the chosen light.
@@ -465,7 +507,7 @@ impl<H: LightHierarchy> CutRules<H> {
         if !ctx.is_finite() {
             return None;
         }
-        Rule::new(self, cut, ctx).sample(d)
+        Rule::new(self, cut, ctx).sample::<false>(d, &mut 0)
     }
 
     /// The probability that [`CutRules::sample`] chooses `light` at `ctx`
@@ -532,6 +574,10 @@ impl<H: LightHierarchy> LightSampler for CutSampler<'_, H> {
 
     fn visibility(&self, _ctx: &ShadingContext, light: LightId) -> f32 {
         self.guide.visibility(self.cut, light)
+    }
+
+    fn sample_with_visibility(&self, ctx: &ShadingContext, u: f32) -> Option<(LightSample, f32)> {
+        self.guide.sample_with_visibility(self.cut, ctx, u)
     }
 }
 

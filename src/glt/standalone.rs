@@ -478,6 +478,12 @@ impl<H: LightHierarchy> LightSampler for Glt<H> {
         self.cut_at(ctx.position)
             .map_or(1.0, |cut| self.guide.visibility(cut, light))
     }
+
+    /// One lookup and one walk.
+    fn sample_with_visibility(&self, ctx: &ShadingContext, u: f32) -> Option<(LightSample, f32)> {
+        let cut = self.cut_at(ctx.position)?;
+        self.guide.sample_with_visibility(cut, ctx, u)
+    }
 }
 
 /// A path vertex located in a [`Glt`] ([`Glt::vertex`]): light selection
@@ -580,5 +586,11 @@ impl<H: LightHierarchy> LightSampler for GltVertex<'_, H> {
     /// The learned visibility of `light` in the located cell.
     fn visibility(&self, _ctx: &ShadingContext, light: LightId) -> f32 {
         self.glt.guide.visibility(self.cut, light)
+    }
+
+    /// One walk: the visibility is read where it leaves the cut.
+    #[inline]
+    fn sample_with_visibility(&self, ctx: &ShadingContext, u: f32) -> Option<(LightSample, f32)> {
+        self.glt.guide.sample_with_visibility(self.cut, ctx, u)
     }
 }

@@ -81,8 +81,14 @@ impl<H: LightHierarchy> CutRules<H> {
         if cut.visibility.is_empty() {
             return 1.0;
         }
-        self.sum_of(cut, light)
-            .and_then(|i| cut.visibility.get(i).copied())
+        self.visibility_at(cut, self.sum_of(cut, light))
+    }
+
+    /// The learned visibility of the slot (or unbounded light) of sum
+    /// `sum` in `cut` (1 for none).
+    #[inline]
+    pub(super) fn visibility_at(&self, cut: &GuidingCut, sum: Option<usize>) -> f32 {
+        sum.and_then(|i| cut.visibility.get(i).copied())
             .unwrap_or(1.0)
     }
 

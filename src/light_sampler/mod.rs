@@ -112,6 +112,15 @@ pub trait LightSampler {
     fn visibility(&self, _ctx: &ShadingContext, _light: LightId) -> f32 {
         1.0
     }
+
+    /// [`LightSampler::sample`] and [`LightSampler::visibility`] of the
+    /// light it chose, equal to calling both; the GLT's samplers read the
+    /// visibility where their walk leaves the cut (one walk instead of
+    /// two: resampling asks this of every candidate).
+    fn sample_with_visibility(&self, ctx: &ShadingContext, u: f32) -> Option<(LightSample, f32)> {
+        let s = self.sample(ctx, u)?;
+        Some((s, self.visibility(ctx, s.light)))
+    }
 }
 
 /// A borrowed or boxed sampler is a sampler (every method forwarded,
@@ -147,6 +156,15 @@ macro_rules! forward_sampler {
             #[inline]
             fn visibility(&self, ctx: &ShadingContext, light: LightId) -> f32 {
                 (**self).visibility(ctx, light)
+            }
+
+            #[inline]
+            fn sample_with_visibility(
+                &self,
+                ctx: &ShadingContext,
+                u: f32,
+            ) -> Option<(LightSample, f32)> {
+                (**self).sample_with_visibility(ctx, u)
             }
         }
     )*};
