@@ -1488,3 +1488,47 @@ fn a_cut_reports_its_fractions_and_memory() {
     );
     assert_eq!(twice.total(), 2 * m.total());
 }
+
+/// A cut that learns visibility counts its parts exactly: its nodes, the
+/// unbounded lights' fractions and every slot's learned visibility (4
+/// bytes each) in the node bytes, the three kinds of sums in the sum bytes;
+/// the heap is both. Its visibility has one entry per slot and unbounded
+/// light, and slots seen a quarter of the time learn about a quarter.
+#[test]
+fn a_cut_with_visibility_counts_every_part() {
+    let mut rng = Rand::new(8);
+    let lights = lights_in_box(&mut rng, 60, 4.0);
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let config = CutConfig {
+        min_splats: 0,
+        visibility: true,
+        unbounded: UnboundedLights::new(3, 0.1).unwrap(),
+        ..CutConfig::default()
+    };
+    let guide = CutRules::new(&tree, config).unwrap();
+    let mut cut = guide.new_cut();
+    for round in 0..2 {
+        for e in 0..60u32 {
+            let l = LightId::Emitter(e);
+            guide.splat_from(&cut, rng.point(3.0), l, 1.0 + e as f32);
+            for k in 0..4 {
+                let seen = if k == 0 { 1.0 } else { 0.0 };
+                guide.splat_visibility(&cut, l, seen, 1.0);
+            }
+        }
+        guide.splat(&cut, LightId::Unbounded(1), 30.0);
+        assert!(guide.refine(&mut cut), "round {round}");
+    }
+    let n = cut.nodes().len();
+    assert!(n > 3, "{n} nodes");
+    let vis = cut.visibility();
+    assert_eq!(vis.len(), 2 * n + 3);
+    // (slots split in the last refine start from the prior, 1)
+    let low = vis[..2 * n].iter().filter(|&&v| v < 0.3).count();
+    assert!(low > n / 2 && vis.iter().all(|&v| v <= 1.0), "{vis:?}");
+    let m = cut.memory();
+    assert_eq!(m.nodes, n);
+    assert_eq!(m.node_bytes, n * CutNode::BYTES + (3 + vis.len()) * 4);
+    assert_eq!(cut.heap_bytes(), m.node_bytes + m.sum_bytes);
+    assert!(m.sum_bytes > 2 * n * 8, "{m:?}");
+}
