@@ -1532,3 +1532,21 @@ fn a_cut_with_visibility_counts_every_part() {
     assert_eq!(cut.heap_bytes(), m.node_bytes + m.sum_bytes);
     assert!(m.sum_bytes > 2 * n * 8, "{m:?}");
 }
+
+/// The anchor (the mean position a cell's splats came from) ignores
+/// splats from non-finite positions entirely: their weight does not
+/// dilute the mean of the others.
+#[test]
+fn the_anchor_ignores_non_finite_positions() {
+    let mut rng = Rand::new(9);
+    let lights = lights_in_box(&mut rng, 30, 4.0);
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let guide = CutRules::new(&tree, CutConfig::default()).unwrap();
+    let cut = guide.new_cut();
+    assert_eq!(cut.anchor(), None);
+    let at = Vec3::new(2.0, -4.0, 6.0);
+    for p in [at, Vec3::NAN, at, Vec3::new(f32::INFINITY, 0.0, 0.0), at] {
+        guide.splat_from(&cut, p, LightId::Emitter(3), 1.0);
+    }
+    assert_eq!(cut.anchor(), Some(at));
+}
