@@ -1550,3 +1550,48 @@ fn the_anchor_ignores_non_finite_positions() {
     }
     assert_eq!(cut.anchor(), Some(at));
 }
+
+/// With the box filter a splat is shared among the cells its box overlaps,
+/// each taking a fraction of its weight; the anchor of each is still the
+/// position the splats came from (the position weighted by its share, over
+/// the shares), whatever the shares.
+#[test]
+fn shared_splats_anchor_where_they_came_from() {
+    use guiding::glt::{Glt, GltConfig};
+    use guiding::spatial::SpatialFilter;
+    let mut rng = Rand::new(12);
+    let lights = lights_in_box(&mut rng, 30, 8.0);
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let config = GltConfig {
+        filter: SpatialFilter::Box,
+        spatial_threshold: 200.0,
+        ..GltConfig::default()
+    };
+    let mut glt = Glt::new(&tree, common::scene(), config).unwrap();
+    let mut jitter = rand_pcg::Pcg32::new(1, 2);
+    for _ in 0..3 {
+        for _ in 0..3000 {
+            let p = rng.point(9.0);
+            glt.splat(p, LightId::Emitter(rng.below(30)), 1.0, &mut jitter);
+        }
+        glt.refine();
+    }
+    let p = Vec3::new(0.013, -0.021, 0.017);
+    for _ in 0..10 {
+        glt.splat(p, LightId::Emitter(4), 1.0, &mut jitter);
+    }
+    let mut anchored = 0;
+    for d in [-0.4f32, 0.0, 0.4] {
+        for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
+            let cut = glt.vertex(p + d * axis).unwrap().cut();
+            if let Some(a) = cut.anchor() {
+                assert!((a - p).length() < 1e-5, "anchor {a} for splats from {p}");
+                anchored += 1;
+            }
+        }
+    }
+    assert!(
+        glt.memory().cells > 8 && anchored > 3,
+        "{anchored} anchored"
+    );
+}
