@@ -18,7 +18,8 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', default_value = crate::scenes::DEFAULT)]
     pub scene: Vec<String>,
     /// Methods, comma separated: pt-uniform, pt-power, pt-bvh, pt-glt, ppg,
-    /// ppg-glt, or `all` [default: pt-bvh,pt-glt,ppg,ppg-glt].
+    /// ppg-glt, ppg+glt (PPG's SD-tree beside a GLT of its own), or `all`
+    /// [default: pt-bvh,pt-glt,ppg,ppg-glt].
     #[arg(long, value_delimiter = ',')]
     pub method: Vec<String>,
     /// Samples per pixel per method (training included); exclusive with

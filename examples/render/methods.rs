@@ -30,17 +30,22 @@ pub enum Method {
     /// spatial tree whose cells hold a quadtree and a cut
     /// (`guiding::field::GuidingField`).
     PpgGlt,
+    /// PPG's own SD-tree for directions beside a GLT on its own spatial
+    /// tree for NEE (two lookups per vertex): what the combined field's
+    /// one subdivision costs or saves.
+    PpgAndGlt,
 }
 
 impl Method {
     /// Every method, in table order.
-    pub const ALL: [Method; 6] = [
+    pub const ALL: [Method; 7] = [
         Method::PtUniform,
         Method::PtPower,
         Method::PtBvh,
         Method::PtGlt,
         Method::Ppg,
         Method::PpgGlt,
+        Method::PpgAndGlt,
     ];
 
     /// The methods a run without arguments compares.
@@ -55,6 +60,7 @@ impl Method {
             Method::PtGlt => "pt-glt",
             Method::Ppg => "ppg",
             Method::PpgGlt => "ppg-glt",
+            Method::PpgAndGlt => "ppg+glt",
         }
     }
 
@@ -65,12 +71,12 @@ impl Method {
 
     /// Trains a Guiding Light Tree on its own spatial tree.
     pub fn uses_glt(self) -> bool {
-        matches!(self, Method::PtGlt)
+        matches!(self, Method::PtGlt | Method::PpgAndGlt)
     }
 
     /// Trains an SD-tree for directional guiding.
     pub fn uses_sd_tree(self) -> bool {
-        matches!(self, Method::Ppg)
+        matches!(self, Method::Ppg | Method::PpgAndGlt)
     }
 
     /// Trains the combined field (quadtree and cut per cell).
@@ -186,7 +192,7 @@ pub fn fixed_sampler<'a>(
         }
         Method::PtPower => Some(wrap(PowerSampler::new(&scene.emitters), scene)),
         Method::PtBvh => Some(wrap(ImportanceTreeSampler::new(&scene.light_tree), scene)),
-        Method::PtGlt | Method::PpgGlt => None,
+        Method::PtGlt | Method::PpgGlt | Method::PpgAndGlt => None,
     }
 }
 

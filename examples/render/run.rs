@@ -66,6 +66,13 @@ impl GuideFiles {
     /// The saved guide's bytes for `method` on `scene`, if asked for and
     /// present.
     fn load(&self, scene: &Scene, method: Method) -> Option<Vec<u8>> {
+        if method == Method::PpgAndGlt && self.load.is_some() {
+            eprintln!(
+                "{}: two guides, not loaded (saved guides hold one)",
+                method.name()
+            );
+            return None;
+        }
         let path = Self::path(self.load.as_ref()?, scene, method);
         match std::fs::read(&path) {
             Ok(b) => Some(b),
@@ -80,6 +87,13 @@ impl GuideFiles {
     /// and says how its size on disk compares with its size in memory.
     fn save(&self, scene: &Scene, method: Method, bytes: &[u8], memory: usize) {
         let Some(dir) = &self.save else { return };
+        if method == Method::PpgAndGlt {
+            eprintln!(
+                "{}: two guides, not saved (saved guides hold one)",
+                method.name()
+            );
+            return;
+        }
         let path = Self::path(dir, scene, method);
         match std::fs::create_dir_all(dir).and_then(|()| std::fs::write(&path, bytes)) {
             Ok(()) => println!(
