@@ -32,9 +32,8 @@ pub struct SdTreeConfig {
     /// not fit (each rebuilt with a coarser `rho` until it has at most that
     /// share of the nodes it would have had; `src/spatial/budget.rs`); then
     /// a spatial split that would take the total above the cap is not
-    /// made. The sampling copy a refine makes is the building topology of
-    /// the iteration before (already within the cap then), so the cap
-    /// binds the memory one iteration after it is reached.
+    /// made. The total is within the cap after every refine, the first
+    /// included (`tests/memory_budget.rs` checks each).
     pub max_bytes: Option<usize>,
     /// The BSDF sampling fraction `s` (probability of sampling the BSDF
     /// rather than the guiding distribution). Fixed when
