@@ -68,6 +68,12 @@ pub mod load {
             ..GltConfig::default()
         };
         let mut glt = Glt::new(tree(), scene, glt_config).unwrap();
+        // A GLT that learns visibility, with a sun and a sky: the
+        // visibility slots and unbounded fractions in the payload.
+        let mut seen_config = glt_config;
+        seen_config.cut.visibility = true;
+        seen_config.cut.unbounded = guiding::UnboundedLights::new(2, 0.2).unwrap();
+        let mut seen = Glt::new(tree(), scene, seen_config).unwrap();
         let mut sd_config = SdTreeConfig::improved();
         sd_config.spatial_threshold = 20.0;
         let mut sd = SdTree::new(scene, sd_config).unwrap();
@@ -87,6 +93,14 @@ pub mod load {
                 let d = Vec3::new(t.cos(), 0.5, t.sin()).normalize();
                 let light = LightId::Emitter(i % 8);
                 glt.splat_at(p, light, 1.0 + (i % 5) as f32);
+                let light_or_sky = if i % 7 == 0 {
+                    LightId::Unbounded(i % 2)
+                } else {
+                    light
+                };
+                seen.splat_at(p, light_or_sky, 1.0 + (i % 5) as f32);
+                let shadowed = if i % 3 == 0 { 0.0 } else { 1.0 };
+                seen.splat_visibility(p, light_or_sky, shadowed, 1.0);
                 let mut j = guiding::spatial::JitterNumbers([0.5, 0.25, 0.75]);
                 sd.vertex(p)
                     .unwrap()
@@ -96,6 +110,7 @@ pub mod load {
                 v.splat_radiance(d, 1.0, 0.5, &mut j);
             }
             glt.refine();
+            seen.refine();
             sd.refine();
             field.refine();
         }
@@ -104,6 +119,7 @@ pub mod load {
             glt.to_bytes(),
             sd.to_bytes(),
             field.to_bytes(),
+            seen.to_bytes(),
         ]
     }
 

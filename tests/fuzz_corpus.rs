@@ -44,11 +44,17 @@ fn load_seeds_and_corpus() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("fuzz/corpus/load/seed-{i}"));
         std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
     };
-    for bytes in [seeds.clone(), (0..4).map(committed).collect()] {
+    for bytes in [seeds.clone(), (0..5).map(committed).collect()] {
         assert!(guiding::LightTree::from_bytes(&bytes[0]).is_ok());
         assert!(guiding::glt::Glt::from_bytes(&bytes[1], tree).is_ok());
         assert!(guiding::sd_tree::SdTree::from_bytes(&bytes[2]).is_ok());
         assert!(guiding::field::GuidingField::from_bytes(&bytes[3], tree).is_ok());
+        // The GLT that learned visibility (and a sun and a sky) has some.
+        let seen = guiding::glt::Glt::from_bytes(&bytes[4], tree).unwrap();
+        let ctx = guiding::ShadingContext::at(glam::Vec3::ZERO);
+        let learned = (0..8)
+            .map(|e| guiding::LightSampler::visibility(&seen, &ctx, guiding::LightId::Emitter(e)));
+        assert!(learned.fold(1.0f32, f32::min) < 0.9);
     }
     for input in inputs("load") {
         checks::load::load(&input);

@@ -258,7 +258,12 @@ fn guided_methods_train_their_structures() {
         s.budget = Budget::Spp(1);
         run::render(&scene, m, &s)
     };
-    for m in [Method::PtGlt, Method::Ppg, Method::PpgGlt, Method::PpgAndGlt] {
+    for m in [
+        Method::PtGlt,
+        Method::Ppg,
+        Method::PpgGlt,
+        Method::PpgAndGlt,
+    ] {
         let (start, trained) = (fresh(m), run::render(&scene, m, &settings));
         assert!(
             trained.iterations >= 5,
