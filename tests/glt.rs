@@ -1595,3 +1595,47 @@ fn shared_splats_anchor_where_they_came_from() {
         "{anchored} anchored"
     );
 }
+
+/// A light without power is never chosen, under the paper's rules (power
+/// ratios all the way down) and the defaults: its pmf is exactly 0 wherever
+/// it sits in the tree, left or right of a lit sibling.
+#[test]
+fn a_light_without_power_has_pmf_zero() {
+    let mut rng = Rand::new(14);
+    let mut lights = lights_in_box(&mut rng, 24, 5.0);
+    let dark = [0usize, 5, 11, 17, 23];
+    for &d in &dark {
+        lights[d].power = 0.0;
+    }
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    // Both sides occur: some dark leaf is a left child, some a right one.
+    let sides: Vec<Side> = dark
+        .iter()
+        .map(|&d| {
+            *tree
+                .path(d as u32)
+                .unwrap()
+                .steps()
+                .last()
+                .map(|(_, s)| s)
+                .unwrap()
+        })
+        .collect();
+    assert!(
+        sides.contains(&Side::Left) && sides.contains(&Side::Right),
+        "{sides:?}"
+    );
+    for config in [
+        CutConfig::default(),
+        CutConfig::default().with_paper_rules(),
+    ] {
+        let guide = CutRules::new(&tree, config).unwrap();
+        let cut = guide.new_cut();
+        for _ in 0..20 {
+            let ctx = ShadingContext::on_surface(rng.point(6.0), rng.dir());
+            for &d in &dark {
+                assert_eq!(guide.pmf_exact(&cut, &ctx, LightId::Emitter(d as u32)), 0.0);
+            }
+        }
+    }
+}
