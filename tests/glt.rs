@@ -1548,6 +1548,17 @@ fn the_anchor_ignores_non_finite_positions() {
     for p in [at, Vec3::NAN, at, Vec3::new(f32::INFINITY, 0.0, 0.0), at] {
         guide.splat_from(&cut, p, LightId::Emitter(3), 1.0);
     }
+    // Splats that record nothing (a zero value, a dropped one) do not
+    // move it either.
+    let elsewhere = Vec3::new(-5.0, 5.0, -5.0);
+    assert_eq!(
+        guide.splat_from(&cut, elsewhere, LightId::Emitter(3), 0.0),
+        SplatOutcome::Zero
+    );
+    assert_eq!(
+        guide.splat_from(&cut, elsewhere, LightId::Emitter(3), -1.0),
+        SplatOutcome::Dropped
+    );
     assert_eq!(cut.anchor(), Some(at));
 }
 
