@@ -33,7 +33,7 @@
 //! equals [`CutRules::pmf_exact`] bit for bit, fallbacks included.
 
 use super::config::{BelowCut, CutConfig, Modulation, Prior};
-use super::cut::GuidingCut;
+use super::cut::{GuidingCut, sum_count};
 use super::cut_node::CutNode;
 use super::cut_rules::{CutRules, decode_split};
 use super::walk::WalkNode;
@@ -337,7 +337,8 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
                 let weight = |i: u32| m.unbounded_pmf(f[i as usize]);
                 let i = choose_unbounded(&mut d, f.len() as u32, weight)?;
                 if SUM {
-                    *sum = (2 * self.nodes.len()).max(1) + i as usize;
+                    // After the cluster sums (`GuidingCut::first_unbounded_sum`).
+                    *sum = sum_count(self.nodes.len(), 0) + i as usize;
                 }
                 return Some((LightId::Unbounded(i), weight(i)));
             }
@@ -375,7 +376,7 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
             let side = d.choose_with(pl, pr);
             self.apply(&mut p, &step, side);
             let k = side.index();
-            if let Some(i) = in_cut.filter(|_| SUM) {
+            if let Some(i) = in_cut {
                 in_cut = step.next[k];
                 if in_cut.is_none() {
                     *sum = 2 * i as usize + k;
@@ -474,12 +475,8 @@ impl<H: LightHierarchy> CutRules<H> {
         ctx: &ShadingContext,
         u: f32,
     ) -> Option<(LightSample, f32)> {
-        if !ctx.is_finite() {
-            return None;
-        }
         let mut sum = 0;
-        let s =
-            to_light_sample(Rule::new(self, cut, ctx).sample::<true>(Descent::new(u), &mut sum))?;
+        let s = to_light_sample(self.sample_at::<true>(cut, ctx, Descent::new(u), &mut sum))?;
         Some((s, self.visibility_at(cut, Some(sum))))
     }
 
@@ -504,10 +501,23 @@ impl<H: LightHierarchy> CutRules<H> {
         ctx: &ShadingContext,
         d: Descent,
     ) -> Option<(LightId, f64)> {
+        self.sample_at::<false>(cut, ctx, d, &mut 0)
+    }
+
+    /// [`Rule::sample`] at `ctx` (nothing at a non-finite position),
+    /// writing the chosen light's sum index to `sum` when `SUM`.
+    #[inline(always)]
+    fn sample_at<const SUM: bool>(
+        &self,
+        cut: &GuidingCut,
+        ctx: &ShadingContext,
+        d: Descent,
+        sum: &mut usize,
+    ) -> Option<(LightId, f64)> {
         if !ctx.is_finite() {
             return None;
         }
-        Rule::new(self, cut, ctx).sample::<false>(d, &mut 0)
+        Rule::new(self, cut, ctx).sample::<SUM>(d, sum)
     }
 
     /// The probability that [`CutRules::sample`] chooses `light` at `ctx`
