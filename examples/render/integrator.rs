@@ -400,60 +400,63 @@ pub fn radiance<'a>(
                 nee.sample(&ctx, s.next())
                     .map(|ls| (ls.light, ls.pmf * draws as f32, None, None))
             };
-            if let Some((light, pmf, resampled, point)) = chosen {
-                let (point, delta) = match point {
-                    Some((lp, delta)) => (Some(lp), delta),
-                    None => point_on(light, s.next2()),
+            let Some((light, pmf, resampled, point)) = chosen else {
+                continue;
+            };
+            let (point, delta) = match point {
+                Some((lp, delta)) => (Some(lp), delta),
+                None => point_on(light, s.next2()),
+            };
+            let ls = guiding::LightSample { light, pmf };
+            let Some(lp) = point else {
+                continue;
+            };
+            let (f, bsdf_pdf) = mat.eval(n, wo, lp.wi);
+            if !(f.max_element() > 0.0 && lp.pdf > 0.0 && lp.radiance.max_element() > 0.0) {
+                continue;
+            }
+            // A delta light has no competing BSDF sample.
+            let p_dir = if delta {
+                0.0
+            } else {
+                dir_pdf(lp.wi, bsdf_pdf).0
+            };
+            // Resampled with the continuation: its weight is the whole
+            // estimate's (no MIS weight); the light the continuation found
+            // is visible.
+            let (factor, known_visible) = match resampled {
+                Some((w, from_bsdf)) => (w / lp.pdf, from_bsdf),
+                None => (
+                    Convention::PbrtV4
+                        .light_sample(ls.pmf, lp.pdf, p_dir)
+                        .factor,
+                    false,
+                ),
+            };
+            let visible = known_visible || {
+                let o = offset_origin(p, n, lp.wi);
+                let target = match ls.light {
+                    LightId::Emitter(e) => e,
+                    LightId::Unbounded(_) => NO_EMITTER,
                 };
-                let ls = guiding::LightSample { light, pmf };
-                if let Some(lp) = point {
-                    let (f, bsdf_pdf) = mat.eval(n, wo, lp.wi);
-                    if f.max_element() > 0.0 && lp.pdf > 0.0 && lp.radiance.max_element() > 0.0 {
-                        // A delta light has no competing BSDF sample.
-                        let p_dir = if delta {
-                            0.0
-                        } else {
-                            dir_pdf(lp.wi, bsdf_pdf).0
-                        };
-                        // Resampled with the continuation: its weight is the
-                        // whole estimate's (no MIS weight); the light the
-                        // continuation found is visible.
-                        let (factor, known_visible) = match resampled {
-                            Some((w, from_bsdf)) => (w / lp.pdf, from_bsdf),
-                            None => (
-                                Convention::PbrtV4
-                                    .light_sample(ls.pmf, lp.pdf, p_dir)
-                                    .factor,
-                                false,
-                            ),
-                        };
-                        let visible = known_visible || {
-                            let o = offset_origin(p, n, lp.wi);
-                            let target = match ls.light {
-                                LightId::Emitter(e) => e,
-                                LightId::Unbounded(_) => NO_EMITTER,
-                            };
-                            !scene.occluded(o, lp.wi, lp.dist, target)
-                        };
-                        let c = f * lp.radiance * factor;
-                        if c.is_finite() {
-                            let value = splat_value(guides, f, lp.radiance) * factor;
-                            if visible {
-                                recorder.add_radiance(c);
-                                if train_light {
-                                    splat_light(guides, &here, ls.light, value, s);
-                                }
-                            }
-                            // Visibility records come from light samples only
-                            // (the continuation's light is visible by
-                            // construction).
-                            if train_light && !known_visible {
-                                let seen = if visible { value } else { 0.0 };
-                                splat_visibility(guides, &here, ls.light, seen, value);
-                            }
-                        }
-                    }
+                !scene.occluded(o, lp.wi, lp.dist, target)
+            };
+            let c = f * lp.radiance * factor;
+            if !c.is_finite() {
+                continue;
+            }
+            let value = splat_value(guides, f, lp.radiance) * factor;
+            if visible {
+                recorder.add_radiance(c);
+                if train_light {
+                    splat_light(guides, &here, ls.light, value, s);
                 }
+            }
+            // Visibility records come from light samples only (the
+            // continuation's light is visible by construction).
+            if train_light && !known_visible {
+                let seen = if visible { value } else { 0.0 };
+                splat_visibility(guides, &here, ls.light, seen, value);
             }
         }
 
