@@ -267,3 +267,41 @@ fn sampling_with_visibility_equals_sampling_then_visibility() {
         );
     }
 }
+
+/// The learned visibility is exactly the module's estimate: the shadowed
+/// over the unshadowed sum, shrunk towards the slot's previous value by
+/// four of the cell's average records, `v = (S + k v0) / (U + k)`, `k = 4
+/// U / records` for a cut of one slot. A rebuild without records keeps
+/// the old value (the shrinkage's `0 / 0` must not become NaN). Controls:
+/// no shrinkage gives 1/8 here, shrinkage by the shadowed sums 1/4.
+#[test]
+fn the_learned_visibility_is_the_shrunk_ratio() {
+    let one = [guiding::Emitter::point(Vec3::ZERO, 1.0)];
+    let tree = LightTree::build(one.as_slice(), BuildHeuristic::Sarh).unwrap();
+    let config = CutConfig {
+        min_splats: 0,
+        visibility: true,
+        ..CutConfig::default()
+    };
+    let guide = guiding::glt::CutRules::new(&tree, config).unwrap();
+    let mut cut = guide.new_cut();
+    let l = LightId::Emitter(0);
+    let mut round = |records: &[(f32, f32)], cut: &mut guiding::glt::GuidingCut| {
+        guide.splat(cut, l, 1.0);
+        for &(s, u) in records {
+            assert_eq!(guide.splat_visibility(cut, l, s, u), SplatOutcome::Recorded);
+        }
+        guide.refine(cut);
+        cut.visibility().to_vec()
+    };
+    assert_eq!(cut.visibility(), &[1.0]);
+    // S = 1, U = 8, 3 records: k = 32 / 3, v = (1 + k) / (8 + k) = 5 / 8.
+    assert_eq!(
+        round(&[(1.0, 2.0), (0.0, 2.0), (0.0, 4.0)], &mut cut),
+        [0.625]
+    );
+    // S = U = 2, one record: k = 8, v = (2 + 8 * 5 / 8) / (2 + 8) = 7 / 10.
+    assert_eq!(round(&[(2.0, 2.0)], &mut cut), [0.7]);
+    // No records: kept.
+    assert_eq!(round(&[], &mut cut), [0.7]);
+}

@@ -225,3 +225,48 @@ fn below(old: &[CutNode], estimates: &[(f64, f64)], i: usize) -> f32 {
     };
     mean as f32
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emitter::Emitter;
+    use crate::glt::CutConfig;
+    use crate::light_sampler::UnboundedLights;
+    use crate::light_tree::{BuildHeuristic, LightTree};
+    use glam::Vec3;
+
+    /// After every refine a cut with unbounded lights keeps one visibility
+    /// per slot and unbounded light, and exactly two visibility sums
+    /// (shadowed, unshadowed) for each: the slots are counted without the
+    /// unbounded lights, which come after them (adding them twice sized
+    /// the sums for lights that do not exist).
+    #[test]
+    fn relearned_visibility_sizes_its_sums_by_slot() {
+        let lights: Vec<Emitter> = (0..40)
+            .map(|i| Emitter::point(Vec3::new(i as f32, (i % 7) as f32, 0.0), 1.0 + i as f32))
+            .collect();
+        let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+        let k = 3;
+        let config = CutConfig {
+            min_splats: 0,
+            visibility: true,
+            unbounded: UnboundedLights::new(k, 0.1).unwrap(),
+            ..CutConfig::default()
+        };
+        let guide = CutRules::new(&tree, config).unwrap();
+        let mut cut = guide.new_cut();
+        for round in 0..3 {
+            for e in 0..40u32 {
+                let l = LightId::Emitter(e);
+                guide.splat(&cut, l, 1.0 + e as f32);
+                guide.splat_visibility(&cut, l, (e % 2) as f32, 1.0);
+            }
+            guide.splat_visibility(&cut, LightId::Unbounded(2), 0.5, 1.0);
+            guide.refine(&mut cut);
+            let slots = visibility_slots(cut.nodes.len(), &config);
+            assert_eq!(cut.visibility.len(), slots, "round {round}");
+            assert_eq!(cut.seen.len(), 2 * slots, "round {round}");
+        }
+        assert!(cut.nodes.len() > 2, "the cut split");
+    }
+}
