@@ -55,6 +55,7 @@ mod scenes;
 mod breakdown;
 mod brute_force;
 mod glt_variant;
+mod per_point_m;
 mod shading_points;
 mod variance;
 
@@ -157,6 +158,25 @@ struct Args {
     /// Write the records as a JSON array here.
     #[arg(long)]
     json: Option<PathBuf>,
+    /// Also print, per GLT variant, the bound of choosing the candidate
+    /// count per point (`per_point_m.rs`): plain sampling and each
+    /// `--resample` count with the BSDF candidate and the first learned
+    /// target (blind without learned visibility), at the costs below.
+    #[arg(long)]
+    per_point_m: bool,
+    /// Instructions per path of plain GLT sampling, for `--per-point-m`
+    /// (callgrind, `pt-glt` on city: docs/results.md).
+    #[arg(long, default_value_t = 29_429.0)]
+    path_cost: f64,
+    /// Resampling's instructions per path besides its candidates, for
+    /// `--per-point-m` (city: 37,345 / 50,357 / 75,339 at M = 2 / 4 / 8
+    /// fit `path + 1,600 + (M - 1) 6,300`).
+    #[arg(long, default_value_t = 1_600.0)]
+    resample_overhead: f64,
+    /// Instructions per resampling candidate after the first, for
+    /// `--per-point-m`.
+    #[arg(long, default_value_t = 6_300.0)]
+    candidate_cost: f64,
     /// Also print, per GLT variant, where its variance comes from (worst
     /// points; lights by how far their pmf is below the clairvoyant's).
     #[arg(long)]
@@ -391,6 +411,18 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
                 ", MIS by the resampled density",
             ),
         ];
+        // The per-point bound's choices: plain sampling, then each count
+        // with the BSDF candidate and the first learned target.
+        let chosen_target = targets
+            .iter()
+            .map(|t| t.1)
+            .find(|t| matches!(t, Target::Learned(_)))
+            .unwrap_or(Target::Blind);
+        let mut choices = vec![per_point_m::Choice {
+            name: variant.name.clone(),
+            candidates: 0,
+            shares: variance::shares(&points, &v),
+        }];
         for &m in &args.resample {
             for &(proxy, proxy_name) in &proxies {
                 for (target, kind) in &targets {
@@ -422,9 +454,33 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
                         variant.name,
                         if seen { ", the BSDF's seen" } else { "" }
                     );
+                    if !seen && kind == chosen_target {
+                        choices.push(per_point_m::Choice {
+                            name: name.clone(),
+                            candidates: m,
+                            shares: variance::shares(&points, &v),
+                        });
+                    }
                     records.push(record(&name, &v, 0, variant.train_spp));
                 }
             }
+        }
+        if args.per_point_m && choices.len() > 1 {
+            println!(
+                "  {}: candidates chosen per point (the bound):",
+                variant.name
+            );
+            print!(
+                "{}",
+                per_point_m::report(
+                    &choices,
+                    per_point_m::Costs {
+                        path: args.path_cost,
+                        overhead: args.resample_overhead,
+                        candidate: args.candidate_cost,
+                    }
+                )
+            );
         }
         // How much of the variance is the BSDF sample's (which a better
         // light choice alone cannot remove), in the relMSE normalisation.

@@ -155,6 +155,12 @@ pub fn clairvoyant(t: &PointTerms) -> Vec<f64> {
 /// normalisation: the mean over points of `Var_i / (I_i^2 + 0.01 mean(I)^2)`
 /// with `I_i` the direct light at point `i`.
 pub fn relative(points: &[PointTerms], variances: &[f64]) -> f64 {
+    shares(points, variances).iter().sum()
+}
+
+/// Each point's share of [`relative`]: its variance over the point's
+/// normalisation, divided by the number of points.
+pub fn shares(points: &[PointTerms], variances: &[f64]) -> Vec<f64> {
     let n = points.len().max(1) as f64;
     let mean_i = points.iter().map(|t| t.direct).sum::<f64>() / n;
     let floor = 0.01 * mean_i * mean_i;
@@ -163,10 +169,9 @@ pub fn relative(points: &[PointTerms], variances: &[f64]) -> f64 {
         .zip(variances)
         .map(|(t, v)| {
             let d = t.direct * t.direct + floor;
-            if d > 0.0 { v / d } else { 0.0 }
+            if d > 0.0 { v / d / n } else { 0.0 }
         })
-        .sum::<f64>()
-        / n
+        .collect()
 }
 
 /// The density both strategies' MIS weights take for a resampled
