@@ -36,7 +36,7 @@
 //! s_l) (sum_l g_l v_l / s_l)` (`t_l = g_l s_l`) is smallest for `s_l`
 //! proportional to `sqrt(v_l)` (Cauchy-Schwarz). Measured on `city` with 8
 //! candidates and the BSDF sample: 1.53 with `v`, 1.13 with `sqrt(v)`,
-//! 1.44 without any (docs/results.md).
+//! 1.44 without any (docs/experiments/light-selection.md).
 //!
 //! One uniform number chooses among the candidates, in a single pass that
 //! keeps only the current choice (weighted reservoir sampling, with the
@@ -49,7 +49,7 @@
 //! The density of the kept light is not known in closed form, so MIS with
 //! a BSDF sample needs care. The better way (on `city` at 8 candidates
 //! the direct light's variance falls from 1.79 with the MIS proxy below to
-//! 1.13, docs/results.md) resamples
+//! 1.13, docs/experiments/light-selection.md) resamples
 //! the BSDF sample *with* the light candidates, as ReSTIR's initial
 //! candidates do: the renderer traces its BSDF sample first (the direction
 //! it continues the path with, or pbrt's separate one), and passes the

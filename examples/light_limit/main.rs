@@ -165,7 +165,7 @@ struct Args {
     #[arg(long)]
     per_point_m: bool,
     /// Instructions per path of plain GLT sampling, for `--per-point-m`
-    /// (callgrind, `pt-glt` on city: docs/results.md).
+    /// (callgrind, `pt-glt` on city: docs/experiments/light-selection.md).
     #[arg(long, default_value_t = 29_429.0)]
     path_cost: f64,
     /// Resampling's instructions per path besides its candidates, for

@@ -119,7 +119,7 @@ pub struct Args {
     /// SD-tree of `ppg` and the combined field of `ppg-glt`. The default is
     /// Müller's improved PPG's, not rescaled for the resolution: at
     /// 256x192 a rescaled 250 doubled `ppg-glt`'s error on `ring` and took
-    /// 15x the memory (docs/results.md, "Spatial thresholds").
+    /// 15x the memory (docs/experiments/settings.md, "Spatial thresholds").
     #[arg(long, default_value_t = 4000.0)]
     pub spatial_threshold: f64,
     /// The same threshold for the GLT's own spatial tree (`pt-glt`), which

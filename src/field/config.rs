@@ -24,8 +24,8 @@ pub struct FieldConfig {
     /// Default [`SpatialFilter::Nearest`], as
     /// [`GltConfig::filter`](crate::glt::GltConfig::filter): a jittered
     /// splat carries light through walls into cells that cannot see it
-    /// (measured in docs/results.md, "Light selection against the physical
-    /// limit").
+    /// (measured in docs/experiments/light-selection.md, "The sealed dim
+    /// room").
     /// [`SpatialFilter::StochasticBox`] draws its jitter as the GLT does
     /// (one `next_u64` per splat).
     pub light_filter: SpatialFilter,

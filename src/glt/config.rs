@@ -19,7 +19,7 @@ pub enum BelowCut {
     ///
     /// Lower variance than [`BelowCut::Power`] for a costlier walk below
     /// the cut (two importance evaluations per level); measured in
-    /// docs/results.md, "Defaults of the cut". The default, with the other
+    /// docs/experiments/settings.md, "Defaults of the cut". The default, with the other
     /// importance rules (see [`CutConfig::with_importance`]).
     #[default]
     Importance,
@@ -91,7 +91,7 @@ pub enum SplitPrior {
     /// Half each, as the paper and its code do. The default: a fresh split
     /// that ignores power explores dim but near clusters sooner, which
     /// helps most when cells have little data (measured in
-    /// docs/results.md, "Defaults of the cut").
+    /// docs/experiments/settings.md, "Defaults of the cut").
     #[default]
     Half,
     /// In the ratio of the children's subtree powers: a freshly split
@@ -121,7 +121,7 @@ pub struct CutConfig {
     ///
     /// Default 0.2: cells learn from few samples, so clusters that matter
     /// but drew no splat must be caught by the floor, and 0.2 costs at most
-    /// 1.25x against a perfect guide (measured in docs/results.md,
+    /// 1.25x against a perfect guide (measured in docs/experiments/settings.md,
     /// "Defaults of the cut"). 0 gives the paper's behaviour (biased for
     /// delta lights the cut never learned).
     pub alpha: f64,
@@ -156,7 +156,7 @@ pub struct CutConfig {
     /// radiance records, not light splats) rebuilds its cut around those
     /// few lights, and only `alpha` stands between it and the rest.
     /// `0` gives the paper's rule (rebuild from any data). Default 64,
-    /// measured (docs/results.md, "The cut's data floor").
+    /// measured (docs/experiments/settings.md, "The cut's data floor").
     pub min_splats: u32,
     /// Learn each cut cluster's visibility: the fraction of its unshadowed
     /// contribution that arrives, from next-event records that carry both
@@ -194,8 +194,8 @@ impl CutConfig {
     /// [`Prior::Importance`]: the learned cut follows the shading point
     /// inside its cell. It costs two importance evaluations per level of
     /// every walk and chooses lights better per sample; in the render
-    /// example it wins at equal time too (docs/results.md, "Light selection
-    /// against the physical limit").
+    /// example it wins at equal time too on a quiet machine
+    /// (docs/experiments/light-selection.md, "At equal time, and per path").
     pub fn with_importance(self) -> Self {
         Self {
             modulation: Modulation::Importance,
