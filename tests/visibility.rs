@@ -286,7 +286,7 @@ fn the_learned_visibility_is_the_shrunk_ratio() {
     let guide = guiding::glt::CutRules::new(&tree, config).unwrap();
     let mut cut = guide.new_cut();
     let l = LightId::Emitter(0);
-    let mut round = |records: &[(f32, f32)], cut: &mut guiding::glt::GuidingCut| {
+    let round = |records: &[(f32, f32)], cut: &mut guiding::glt::GuidingCut| {
         guide.splat(cut, l, 1.0);
         for &(s, u) in records {
             assert_eq!(guide.splat_visibility(cut, l, s, u), SplatOutcome::Recorded);
