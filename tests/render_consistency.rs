@@ -2,7 +2,8 @@
 //! method: per-method image means (whole image and quadrants) agree with an
 //! independent reference within their statistical error on `box`, on a small many-light scene (`ring`
 //! with 1,536 lights) and on `few-lights` (environment light). And the
-//! `embed` example runs and passes its own checks.
+//! `embed` example runs and passes its own checks. And the reference
+//! committed for the default job belongs to the default scene as it is.
 //!
 //! The example's modules are compiled in here as they are (`#[path]`), so
 //! the test exercises exactly the code the example runs.
@@ -420,4 +421,67 @@ fn references_are_extended_not_rerendered() {
     assert_eq!(again.origin, reference::Origin::Cached);
     assert_eq!(again.image, long.image);
     std::fs::remove_dir_all(&out).ok();
+}
+
+/// The reference committed for the README's main job is the default
+/// scene's at the default size, as the scene is now: a change of the scene
+/// (its fingerprint) without a new committed reference fails here, so the
+/// main job never silently renders its reference again or compares against
+/// another scene's. It loads as the job loads it, holds a long render, and
+/// an extension of it is written to the cache, never to the repository.
+#[test]
+fn the_committed_reference_is_the_default_scenes() {
+    let scene = scenes::build(scenes::DEFAULT, scenes::Size::Full).unwrap();
+    let (w, h) = scenes::DEFAULT_SIZE;
+    let committed = std::path::Path::new(reference::COMMITTED);
+    let stem = reference::stem_in(committed, &scene, w, h, Method::PtBvh);
+    let (img, var, meta) = reference::paths(&stem);
+    for f in [&img, &var, &meta] {
+        assert!(
+            f.exists(),
+            "no committed reference {} for the default scene {} (fingerprint {:016x}): render one \
+             with `cargo run --release --example render -- --reference-only --reference-spp 4096 \
+             --export-reference examples/render/references` (examples/render/references/README.md)",
+            f.display(),
+            scenes::DEFAULT,
+            scene.fingerprint
+        );
+    }
+    let out = std::env::temp_dir().join(format!("guiding-committed-{}", std::process::id()));
+    let settings = Settings {
+        width: w,
+        height: h,
+        budget: Budget::Spp(1),
+        params: GuideParams::default(),
+        seed: 1,
+        progress: false,
+        guide_files: Default::default(),
+    };
+    let r = reference::load_or_render(
+        &scene,
+        &out,
+        &settings,
+        Method::PtBvh,
+        Budget::Spp(1),
+        false,
+    )
+    .unwrap();
+    assert_eq!(r.origin, reference::Origin::Committed);
+    assert_eq!(r.image.len(), (w * h) as usize);
+    assert!(r.mean > 0.0 && r.mean.is_finite());
+    let spp: u64 = r
+        .provenance
+        .split_whitespace()
+        .nth(1)
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(spp >= 4096, "{}", r.provenance);
+    // Nothing was written to the cache: the budget was met.
+    assert!(!out.exists());
+    // Control: another scene's fingerprint finds nothing committed.
+    let mut other = scene;
+    other.fingerprint ^= 1;
+    let stem = reference::stem_in(committed, &other, w, h, Method::PtBvh);
+    assert!(!reference::paths(&stem).0.exists());
 }

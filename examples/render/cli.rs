@@ -30,10 +30,10 @@ pub struct Args {
     #[arg(long)]
     pub seconds: Option<f64>,
     /// Image width.
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = crate::scenes::DEFAULT_SIZE.0)]
     pub width: u32,
     /// Image height.
-    #[arg(long, default_value_t = 192)]
+    #[arg(long, default_value_t = crate::scenes::DEFAULT_SIZE.1)]
     pub height: u32,
     /// Output directory (images, comparison sheets, reference cache).
     #[arg(long, default_value = "out")]
@@ -142,9 +142,14 @@ pub struct Args {
     /// reference is made once and cached for later runs.
     #[arg(long)]
     pub reference_only: bool,
-    /// Re-render references even when cached.
+    /// Re-render references even when cached (or committed).
     #[arg(long)]
     pub rebuild_reference: bool,
+    /// Also write each scene's reference to DIR in half floats, named as
+    /// the references committed to the repository are
+    /// (`examples/render/references`): how a committed reference is made.
+    #[arg(long, value_name = "DIR")]
+    pub export_reference: Option<PathBuf>,
     /// Seed of every random stream.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,

@@ -224,23 +224,36 @@ fn run_scene(
         reference_budget,
         args.rebuild_reference,
     )?;
+    let (w, h) = (settings.width, settings.height);
+    let stem = match reference.origin {
+        reference::Origin::Committed => reference::stem_in(
+            std::path::Path::new(reference::COMMITTED),
+            &scene,
+            w,
+            h,
+            reference_method,
+        ),
+        _ => reference::cache_stem(&args.out, &scene, w, h, reference_method),
+    };
     println!(
         "reference: {} ({}){}",
         reference.provenance,
-        reference::cache_stem(
-            &args.out,
-            &scene,
-            settings.width,
-            settings.height,
-            reference_method
-        )
-        .display(),
+        stem.display(),
         match reference.origin {
             reference::Origin::Cached => ", cached".to_string(),
+            reference::Origin::Committed => ", committed to the repository".to_string(),
             reference::Origin::Rendered => String::new(),
-            reference::Origin::Extended(spp) => format!(", extended from the cached {spp} spp"),
+            reference::Origin::Extended(spp) => format!(", extended from the {spp} spp it had"),
         }
     );
+    if let Some(dir) = &args.export_reference {
+        let note = format!(
+            "scene {name} (fingerprint {:016x}), {w}x{h}, exported by `render --export-reference`",
+            scene.fingerprint
+        );
+        let stem = reference::export(&reference, dir, &scene, (w, h), reference_method, &note)?;
+        println!("reference exported to {}", stem.display());
+    }
     if args.reference_only {
         let floor = metrics::errors(&reference.image, &reference).relmse_floor;
         return Ok((Vec::new(), format!("reference: own relMSE {floor:.2e}")));

@@ -2,7 +2,7 @@
 //! scene, resolution and scene fingerprint, with its per-pixel variance so
 //! error estimates can discount the reference's own noise.
 
-use crate::film::{read_exr, write_exr};
+use crate::film::{read_exr, write_exr, write_exr_half};
 use crate::methods::Method;
 use crate::report::Record;
 use crate::run::{Budget, Settings, render};
@@ -25,10 +25,17 @@ pub struct Reference {
     pub origin: Origin,
 }
 
-/// The cache files' common stem:
-/// `<out>/references/<scene>-<w>x<h>-<method>-<hash>`.
-pub fn cache_stem(out: &Path, scene: &Scene, width: u32, height: u32, method: Method) -> PathBuf {
-    out.join("references").join(format!(
+/// Where references committed to the repository live: the default scene's
+/// at the default size, so a first run does not spend most of its time
+/// rendering one (`references/README.md` there says how each was made).
+pub const COMMITTED: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/render/references");
+
+/// The common stem of a reference's files in `dir`:
+/// `<dir>/<scene>-<w>x<h>-<method>-<hash>` (`.exr`, `-variance.exr`,
+/// `.txt` with the provenance on its first line). The hash is the scene's
+/// fingerprint, so a reference of a scene that changed is never used.
+pub fn stem_in(dir: &Path, scene: &Scene, width: u32, height: u32, method: Method) -> PathBuf {
+    dir.join(format!(
         "{}-{}x{}-{}-{:08x}",
         scene.name,
         width,
@@ -36,6 +43,20 @@ pub fn cache_stem(out: &Path, scene: &Scene, width: u32, height: u32, method: Me
         method.name(),
         scene.fingerprint as u32
     ))
+}
+
+/// The cache files' common stem: [`stem_in`] `<out>/references`.
+pub fn cache_stem(out: &Path, scene: &Scene, width: u32, height: u32, method: Method) -> PathBuf {
+    stem_in(&out.join("references"), scene, width, height, method)
+}
+
+/// The image, variance and provenance paths of a stem.
+pub fn paths(stem: &Path) -> (PathBuf, PathBuf, PathBuf) {
+    (
+        stem.with_extension("exr"),
+        PathBuf::from(format!("{}-variance.exr", stem.display())),
+        stem.with_extension("txt"),
+    )
 }
 
 /// A line saying how trustworthy `reference` is against the best of the
@@ -82,6 +103,9 @@ pub fn seconds_of(reference: &Reference) -> Option<f64> {
 pub enum Origin {
     /// Loaded from the cache as it was.
     Cached,
+    /// Loaded from the references committed to the repository
+    /// ([`COMMITTED`]), which hold at least what was asked for.
+    Committed,
     /// Rendered now (no usable cache).
     Rendered,
     /// The cache held this many samples per pixel, fewer than asked for:
@@ -107,10 +131,14 @@ fn parse_provenance(line: &str) -> Option<(u64, f64)> {
     }
 }
 
-fn read_cache(img: &Path, var: &Path, meta: &Path, width: u32, height: u32) -> Option<Cache> {
-    let (w, h, image) = read_exr(img).ok()?;
-    let (vw, vh, variance) = read_exr(var).ok()?;
-    let (spp, seconds) = parse_provenance(std::fs::read_to_string(meta).ok()?.trim())?;
+/// The reference at `stem`, if its files are there, readable and of
+/// `width` x `height`.
+fn read_cache(stem: &Path, width: u32, height: u32) -> Option<Cache> {
+    let (img, var, meta) = paths(stem);
+    let (w, h, image) = read_exr(&img).ok()?;
+    let (vw, vh, variance) = read_exr(&var).ok()?;
+    let meta = std::fs::read_to_string(meta).ok()?;
+    let (spp, seconds) = parse_provenance(meta.lines().next()?.trim())?;
     ((w, h) == (width, height) && (vw, vh) == (w, h)).then_some(Cache {
         image,
         variance,
@@ -129,11 +157,13 @@ fn still_to_render(budget: Budget, spp: u64, seconds: f64) -> Option<Budget> {
     }
 }
 
-/// Loads the cached reference if it holds at least `budget`; otherwise
-/// renders what is missing with `method` (fresh random streams, so every
-/// part is independent), averages it with the cache weighted by samples
-/// per pixel, and writes the result back. A reference therefore only
-/// grows: asking for a longer one extends it. `rebuild` ignores the cache.
+/// Loads the cached reference if it holds at least `budget`, else the
+/// committed one ([`COMMITTED`]) if there is one for this scene, size and
+/// method that does; otherwise renders what is missing with `method`
+/// (fresh random streams, so every part is independent), averages it with
+/// the cache (or the committed reference) weighted by samples per pixel,
+/// and writes the result to the cache. A reference therefore only grows:
+/// asking for a longer one extends it. `rebuild` ignores both.
 pub fn load_or_render(
     scene: &Scene,
     out: &Path,
@@ -143,33 +173,32 @@ pub fn load_or_render(
     rebuild: bool,
 ) -> Result<Reference, String> {
     let stem = cache_stem(out, scene, settings.width, settings.height, method);
-    let (img_path, var_path, meta_path) = (
-        stem.with_extension("exr"),
-        PathBuf::from(format!("{}-variance.exr", stem.display())),
-        stem.with_extension("txt"),
-    );
-    let cache = if rebuild {
-        None
-    } else {
-        read_cache(
-            &img_path,
-            &var_path,
-            &meta_path,
-            settings.width,
-            settings.height,
-        )
+    let (img_path, var_path, meta_path) = paths(&stem);
+    let (w, h) = (settings.width, settings.height);
+    let read = |dir: &Path| {
+        (!rebuild)
+            .then(|| read_cache(&stem_in(dir, scene, w, h, method), w, h))
+            .flatten()
     };
-    let (have_spp, have_seconds) = cache.as_ref().map_or((0, 0.0), |c| (c.spp, c.seconds));
+    // Start from whichever holds more samples.
+    let cache = match (read(&out.join("references")), read(Path::new(COMMITTED))) {
+        (Some(c), Some(k)) if k.spp > c.spp => Some((k, Origin::Committed)),
+        (Some(c), _) => Some((c, Origin::Cached)),
+        (None, Some(k)) => Some((k, Origin::Committed)),
+        (None, None) => None,
+    };
+    let (have_spp, have_seconds) = cache.as_ref().map_or((0, 0.0), |c| (c.0.spp, c.0.seconds));
     let Some(more) = still_to_render(budget, have_spp, have_seconds) else {
-        let c = cache.expect("a budget is only met by a cache");
+        let (c, origin) = cache.expect("a budget is only met by a cache");
         return Ok(Reference {
             mean: mean_luminance(&c.image),
             image: c.image,
             variance: c.variance,
             provenance: format!("{} {} spp {:.1} s", method.name(), c.spp, c.seconds),
-            origin: Origin::Cached,
+            origin,
         });
     };
+    let cache = cache.map(|c| c.0);
     let mut s = settings.clone();
     s.budget = more;
     // Each part's streams depend on the samples already held, so an
@@ -222,4 +251,26 @@ fn mean_luminance(px: &[Vec3]) -> f64 {
         .map(|p| f64::from(crate::lights::luminance(*p)))
         .sum::<f64>()
         / px.len().max(1) as f64
+}
+
+/// Writes `reference` to `dir` in half floats, named as the committed
+/// references are ([`stem_in`]), with its provenance and `note` (how it was
+/// made) in the text file: what `--export-reference` does to make a
+/// reference to commit.
+pub fn export(
+    reference: &Reference,
+    dir: &Path,
+    scene: &Scene,
+    (width, height): (u32, u32),
+    method: Method,
+    note: &str,
+) -> Result<PathBuf, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let stem = stem_in(dir, scene, width, height, method);
+    let (img, var, meta) = paths(&stem);
+    write_exr_half(&img, width, height, &reference.image)?;
+    write_exr_half(&var, width, height, &reference.variance)?;
+    std::fs::write(&meta, format!("{}\n{note}\n", reference.provenance))
+        .map_err(|e| format!("{}: {e}", meta.display()))?;
+    Ok(stem)
 }
