@@ -6,10 +6,11 @@ use std::path::PathBuf;
 
 /// Renders the paper's scene analogues with every light-sampling and
 /// guiding method at equal time or equal samples, and measures their error
-/// against a cached reference.
+/// against a cached (or committed) reference.
 ///
-/// Without arguments: the default scene with the main methods at equal
-/// time (reference included on the first run), then a table.
+/// Without arguments: the default scene (city-street) with the main
+/// methods at equal time, against the reference committed for it, then a
+/// table.
 #[derive(Parser, Debug, Clone)]
 #[command(name = "render", version)]
 pub struct Args {
