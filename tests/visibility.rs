@@ -305,3 +305,54 @@ fn the_learned_visibility_is_the_shrunk_ratio() {
     // No records: kept.
     assert_eq!(round(&[], &mut cut), [0.7]);
 }
+
+/// Where a rebuilt cut is coarser than the old one, a new slot takes the
+/// mean visibility of the old slots below it: lights learned hidden stay
+/// hidden when the cut stops resolving them (the records moved elsewhere).
+/// Control: taking 1 for such a slot (forgetting what was learned).
+#[test]
+fn a_coarser_cut_keeps_what_its_finer_slots_learned() {
+    let lights: Vec<guiding::Emitter> = (0..16)
+        .map(|i| guiding::Emitter::point(Vec3::new(i as f32, 0.0, 0.0), 1.0))
+        .collect();
+    let tree = LightTree::build(lights.as_slice(), BuildHeuristic::Sarh).unwrap();
+    let config = CutConfig {
+        min_splats: 0,
+        visibility: true,
+        ..CutConfig::default()
+    };
+    let guide = guiding::glt::CutRules::new(&tree, config).unwrap();
+    let mut cut = guide.new_cut();
+    let round = |lit: std::ops::Range<u32>, cut: &mut guiding::glt::GuidingCut| {
+        for e in lit {
+            let l = LightId::Emitter(e);
+            for _ in 0..8 {
+                guide.splat(cut, l, 100.0);
+                // The left half is hidden, the right half seen.
+                let seen = if e < 8 { 0.0 } else { 1.0 };
+                guide.splat_visibility(cut, l, seen, 1.0);
+            }
+        }
+        guide.refine(cut);
+    };
+    // Three rounds resolving every light, then one whose records are all on
+    // the right: the cut no longer splits the left half.
+    for _ in 0..3 {
+        round(0..16, &mut cut);
+    }
+    let fine = cut.nodes().len();
+    let hidden = guide.visibility(&cut, LightId::Emitter(2));
+    assert!(hidden < 0.2, "{hidden}");
+    round(8..16, &mut cut);
+    assert!(
+        cut.nodes().len() < fine,
+        "{} nodes, {fine} before",
+        cut.nodes().len()
+    );
+    let kept = guide.visibility(&cut, LightId::Emitter(2));
+    assert!(
+        kept < 0.2,
+        "the left half's visibility {kept}, {hidden} before"
+    );
+    assert!(guide.visibility(&cut, LightId::Emitter(12)) > 0.8);
+}
