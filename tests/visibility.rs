@@ -350,9 +350,61 @@ fn a_coarser_cut_keeps_what_its_finer_slots_learned() {
         cut.nodes().len()
     );
     let kept = guide.visibility(&cut, LightId::Emitter(2));
-    assert!(
-        kept < 0.2,
-        "the left half's visibility {kept}, {hidden} before"
-    );
+    // Every old slot below it learned the floor: their mean is the floor.
+    assert_eq!(kept, hidden, "the left half's visibility");
     assert!(guide.visibility(&cut, LightId::Emitter(12)) > 0.8);
+}
+
+/// The mean over the old slots below a coarser slot weighs each by its
+/// unshadowed records: a hidden quarter that still sends records outweighs
+/// a seen quarter that sends none (the plain mean would be about 1/2).
+#[test]
+fn a_coarser_slot_weighs_its_old_slots_by_their_records() {
+    let lights: Vec<guiding::Emitter> = (0..16)
+        .map(|i| guiding::Emitter::point(Vec3::new(i as f32, 0.0, 0.0), 1.0))
+        .collect();
+    let tree = LightTree::build(lights.as_slice(), BuildHeuristic::Sarh).unwrap();
+    let config = CutConfig {
+        min_splats: 0,
+        visibility: true,
+        ..CutConfig::default()
+    };
+    let guide = guiding::glt::CutRules::new(&tree, config).unwrap();
+    let mut cut = guide.new_cut();
+    // Lights 0-3 hidden, 4-15 seen; `splat` says which lights the cut
+    // resolves, `records` which send visibility records.
+    let round = |splat: std::ops::Range<u32>,
+                 records: std::ops::Range<u32>,
+                 cut: &mut guiding::glt::GuidingCut| {
+        for e in splat {
+            guide.splat(cut, LightId::Emitter(e), 100.0);
+        }
+        for e in records {
+            let seen = if e < 4 { 0.0 } else { 1.0 };
+            for _ in 0..8 {
+                guide.splat_visibility(cut, LightId::Emitter(e), seen, 1.0);
+            }
+        }
+        guide.refine(cut);
+    };
+    for _ in 0..3 {
+        round(0..16, 0..16, &mut cut);
+    }
+    let (hidden, seen) = (
+        guide.visibility(&cut, LightId::Emitter(1)),
+        guide.visibility(&cut, LightId::Emitter(6)),
+    );
+    assert!(hidden < 0.1 && seen > 0.9, "{hidden} {seen}");
+    let fine = cut.nodes().len();
+    // The cut stops resolving the left half; only the hidden quarter
+    // still sends records.
+    round(8..16, 0..4, &mut cut);
+    assert!(cut.nodes().len() < fine);
+    let merged = guide.visibility(&cut, LightId::Emitter(1));
+    assert_eq!(
+        merged,
+        guide.visibility(&cut, LightId::Emitter(6)),
+        "one slot"
+    );
+    assert!(merged > 0.0 && merged < 0.2, "{merged}");
 }
