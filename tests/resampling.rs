@@ -288,6 +288,12 @@ fn bad_evaluations_are_ignored() {
         let bsdf = Some((LightId::Emitter(1), evaluated(d)));
         let found = resample(&s, &ctx, &[], 0.5, bsdf, |_, _| None);
         assert!(found.is_none(), "{d:?}");
+        // Beside light candidates (whose weights would make it count).
+        for u in [0.1, 0.5, 0.9] {
+            let light = |_, _| Some(Evaluated::new(1.0, ()));
+            let with = resample(&s, &ctx, &cands, u, bsdf, light);
+            assert_eq!(with, resample(&s, &ctx, &cands, u, None, light), "{d:?}");
+        }
     }
 }
 
@@ -382,37 +388,51 @@ fn the_bsdf_sample_as_a_candidate_is_unbiased() {
         .sum::<f64>()
         / 100_000.0;
     let pdf_bsdf = |y: f32| y / 8.0;
+    // Points on a light: uniform (density 1), or warped to density
+    // `0.5 + t` at `t = y - k` (so that `p_b / p_l` differs from `p_b`).
+    let density = |warp: bool, t: f32| if warp { 0.5 + t } else { 1.0 };
+    let point = |warp: bool, u: f32| {
+        if warp {
+            -0.5 + (0.25 + 2.0 * u).sqrt()
+        } else {
+            u
+        }
+    };
     let ctx = ShadingContext::at(Vec3::ZERO);
-    let run = |s: &dyn LightSampler, m: usize, densities: bool, seed: u64| {
+    let run = |s: &dyn LightSampler, m: usize, densities: bool, warp: bool, seed: u64| {
         let mut rng = Rand::new(seed);
         let n = 200_000;
         let (mut s1, mut s2) = (0.0f64, 0.0f64);
         let mut cands = vec![0.0f32; m];
         for _ in 0..n {
             cands.iter_mut().for_each(|c| *c = rng.f());
-            let ys: Vec<f32> = (0..m).map(|_| rng.f()).collect();
+            let ys: Vec<f32> = (0..m).map(|_| point(warp, rng.f())).collect();
             // The BSDF sample: `y = 4 sqrt(u)` has density `y / 8`; its
             // ray stops where the light is blocked.
             let y = 4.0 * rng.f().sqrt();
             let k = (y as u32).min(3);
             let bsdf = visible(k, y).then(|| {
-                let e = Evaluated::new(radiance(k, y), (k, y)).with_densities(1.0, pdf_bsdf(y));
+                let pl = density(warp, y - k as f32);
+                let e = Evaluated::new(radiance(k, y) / pl, (k, y)).with_densities(pl, pdf_bsdf(y));
                 (LightId::Emitter(k), e)
             });
             let r = resample(s, &ctx, &cands, rng.f(), bsdf, |l, j| {
                 let LightId::Emitter(k) = l else { return None };
                 let y = k as f32 + ys[j];
-                let e = Evaluated::new(radiance(k, y), (k, y));
+                let pl = density(warp, ys[j]);
+                let e = Evaluated::new(radiance(k, y) / pl, (k, y));
                 Some(if densities {
-                    e.with_densities(1.0, pdf_bsdf(y))
+                    e.with_densities(pl, pdf_bsdf(y))
                 } else {
                     e
                 })
             });
+            // The kept light's estimate `Le / p_l` times the weight.
             let x = r.map_or(0.0, |r| {
                 let (k, y) = r.payload;
                 if r.bsdf || visible(k, y) {
-                    f64::from(radiance(k, y)) * f64::from(r.weight)
+                    let pl = density(warp, y - k as f32);
+                    f64::from(radiance(k, y) / pl) * f64::from(r.weight)
                 } else {
                     0.0
                 }
@@ -427,14 +447,23 @@ fn the_bsdf_sample_as_a_candidate_is_unbiased() {
     let three = UniformSampler::new(3);
     for (name, s) in [("all", &all), ("three", &three)] {
         for m in [0usize, 1, 4] {
-            let (mean, se) = run(s, m, true, 40 + m as u64);
+            let (mean, se) = run(s, m, true, false, 40 + m as u64);
             assert!(
                 (mean - truth).abs() < 4.5 * se,
                 "{name}, M = {m}: {mean} +- {se} vs {truth}"
             );
         }
     }
-    let (biased, se) = run(&all, 4, false, 99);
+    // Light points of density other than 1: the BSDF's share in each
+    // weight is `p_b / p_l` (`p_b p_l` in its place was unbiased above).
+    for m in [1usize, 4] {
+        let (mean, se) = run(&all, m, true, true, 60 + m as u64);
+        assert!(
+            (mean - truth).abs() < 4.5 * se,
+            "warped, M = {m}: {mean} +- {se} vs {truth}"
+        );
+    }
+    let (biased, se) = run(&all, 4, false, false, 99);
     assert!(
         (biased - truth).abs() > 10.0 * se,
         "control: {biased} +- {se} vs {truth}"
