@@ -278,12 +278,7 @@ fn sampling_with_visibility_equals_sampling_then_visibility() {
 fn the_learned_visibility_is_the_shrunk_ratio() {
     let one = [guiding::Emitter::point(Vec3::ZERO, 1.0)];
     let tree = LightTree::build(one.as_slice(), BuildHeuristic::Sarh).unwrap();
-    let config = CutConfig {
-        min_splats: 0,
-        visibility: true,
-        ..CutConfig::default()
-    };
-    let guide = guiding::glt::CutRules::new(&tree, config).unwrap();
+    let guide = guiding::glt::CutRules::new(&tree, learning_visibility()).unwrap();
     let mut cut = guide.new_cut();
     let l = LightId::Emitter(0);
     let round = |records: &[(f32, f32)], cut: &mut guiding::glt::GuidingCut| {
@@ -312,16 +307,8 @@ fn the_learned_visibility_is_the_shrunk_ratio() {
 /// Control: taking 1 for such a slot (forgetting what was learned).
 #[test]
 fn a_coarser_cut_keeps_what_its_finer_slots_learned() {
-    let lights: Vec<guiding::Emitter> = (0..16)
-        .map(|i| guiding::Emitter::point(Vec3::new(i as f32, 0.0, 0.0), 1.0))
-        .collect();
-    let tree = LightTree::build(lights.as_slice(), BuildHeuristic::Sarh).unwrap();
-    let config = CutConfig {
-        min_splats: 0,
-        visibility: true,
-        ..CutConfig::default()
-    };
-    let guide = guiding::glt::CutRules::new(&tree, config).unwrap();
+    let tree = row_of_lights();
+    let guide = guiding::glt::CutRules::new(&tree, learning_visibility()).unwrap();
     let mut cut = guide.new_cut();
     let round = |lit: std::ops::Range<u32>, cut: &mut guiding::glt::GuidingCut| {
         for e in lit {
@@ -360,16 +347,8 @@ fn a_coarser_cut_keeps_what_its_finer_slots_learned() {
 /// a seen quarter that sends none (the plain mean would be about 1/2).
 #[test]
 fn a_coarser_slot_weighs_its_old_slots_by_their_records() {
-    let lights: Vec<guiding::Emitter> = (0..16)
-        .map(|i| guiding::Emitter::point(Vec3::new(i as f32, 0.0, 0.0), 1.0))
-        .collect();
-    let tree = LightTree::build(lights.as_slice(), BuildHeuristic::Sarh).unwrap();
-    let config = CutConfig {
-        min_splats: 0,
-        visibility: true,
-        ..CutConfig::default()
-    };
-    let guide = guiding::glt::CutRules::new(&tree, config).unwrap();
+    let tree = row_of_lights();
+    let guide = guiding::glt::CutRules::new(&tree, learning_visibility()).unwrap();
     let mut cut = guide.new_cut();
     // Lights 0-3 hidden, 4-15 seen; `splat` says which lights the cut
     // resolves, `records` which send visibility records.
@@ -407,4 +386,21 @@ fn a_coarser_slot_weighs_its_old_slots_by_their_records() {
         "one slot"
     );
     assert!(merged > 0.0 && merged < 0.2, "{merged}");
+}
+
+/// A cut that learns visibility and rebuilds from any data.
+fn learning_visibility() -> CutConfig {
+    CutConfig {
+        min_splats: 0,
+        visibility: true,
+        ..CutConfig::default()
+    }
+}
+
+/// 16 point lights of power 1 in a row along x.
+fn row_of_lights() -> LightTree {
+    let lights: Vec<guiding::Emitter> = (0..16)
+        .map(|i| guiding::Emitter::point(Vec3::new(i as f32, 0.0, 0.0), 1.0))
+        .collect();
+    LightTree::build(lights.as_slice(), BuildHeuristic::Sarh).unwrap()
 }
