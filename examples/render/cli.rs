@@ -143,6 +143,12 @@ pub struct Args {
     /// reference is made once and cached for later runs.
     #[arg(long)]
     pub reference_only: bool,
+    /// Render nothing: read the records of an earlier `--json FILE` and
+    /// redraw each scene's plots in `<out>/<scene>/` and print its tables
+    /// (how the plots under docs/plots are redrawn from the data committed
+    /// beside them).
+    #[arg(long, value_name = "FILE")]
+    pub replot: Option<PathBuf>,
     /// Re-render references even when cached (or committed).
     #[arg(long)]
     pub rebuild_reference: bool,

@@ -22,6 +22,7 @@ mod crossing;
 mod film;
 mod geometry;
 mod integrator;
+mod json;
 mod lights;
 mod materials;
 mod methods;
@@ -35,6 +36,7 @@ mod run;
 mod scene;
 mod scenes;
 mod sheet;
+mod text;
 
 use clap::Parser;
 use guiding::spatial::SpatialFilter;
@@ -92,6 +94,9 @@ fn selection(args: &cli::Args) -> Result<(Vec<String>, Vec<Method>), String> {
 const REFERENCE_TIMES: f64 = 40.0;
 
 fn run_all(args: &cli::Args) -> Result<(), String> {
+    if let Some(path) = &args.replot {
+        return replot(path, &args.out);
+    }
     if let Some(n) = args.threads {
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
@@ -179,6 +184,32 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
         std::fs::write(path, report::to_json(&all))
             .map_err(|e| format!("{}: {e}", path.display()))?;
         println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// Redraws the plots of the records in the JSON file `path` under
+/// `out/<scene>/` and prints their tables.
+fn replot(path: &Path, out: &Path) -> Result<(), String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let all = report::from_json(&text)?;
+    let mut scenes: Vec<&str> = all.iter().map(|r| r.scene.as_str()).collect();
+    scenes.dedup();
+    for name in scenes {
+        let records: Vec<Record> = all.iter().filter(|r| r.scene == name).cloned().collect();
+        println!("{}", report::table(&records));
+        print!("{}", report::curve_table(&records));
+        let dir = out.join(name);
+        std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        if records.iter().any(|r| !r.curve.is_empty()) {
+            let [svg, png] = plot::convergence(&dir.join("convergence"), name, &records)?;
+            println!("{name}: {} and {}", svg.display(), png.display());
+        }
+        if records.iter().any(|r| r.method.contains(" s=")) {
+            let [svg, png] = plot::sigma_study(&dir.join("sigma"), name, &records)?;
+            println!("{name}: {} and {}", svg.display(), png.display());
+        }
+        println!("{}", crossing::describe(&crossing::crossings(&records)));
     }
     Ok(())
 }
@@ -331,18 +362,15 @@ fn run_scene(
     }
     let mut panels = vec![sheet::Panel {
         image: &reference.image,
-        lines: vec![
-            "reference".into(),
-            reference.provenance.clone().replace(" spp", "spp"),
-        ],
+        lines: vec!["reference".into(), reference.provenance.clone()],
     }];
     for (method, r, e) in &rendered {
         panels.push(sheet::Panel {
             image: &r.image,
             lines: vec![
                 method.clone(),
-                format!("rmse {:.4}", e.rmse),
-                format!("{} spp {:.0} s", r.spp, r.seconds),
+                format!("RMSE {:.4}", e.rmse),
+                format!("{} spp, {:.0} s", r.spp, r.seconds),
             ],
         });
     }

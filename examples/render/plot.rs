@@ -1,6 +1,6 @@
 //! Convergence plots: relMSE against render time, log-log, one line per
-//! method, each written as SVG (text as SVG text) and as PNG (text in the
-//! built-in pixel font): no font files needed.
+//! method, each written as SVG (text as SVG text, in the reader's
+//! sans-serif) and as PNG (text in DejaVu Sans, `text.rs`).
 
 use crate::raster::{Canvas, Viewport};
 use crate::report::Record;
@@ -69,17 +69,59 @@ fn with_decade(lo: f64, hi: f64) -> (f64, f64) {
 }
 
 /// The label of the log axis tick at `v` on an axis spanning `range`:
-/// written by `format` when the axis spans less than a decade (few ticks),
-/// otherwise only at 1, 2 and 5 times a power of ten, so labels never
-/// crowd.
-fn tick(v: f64, range: (f64, f64), format: impl Fn(f64) -> String) -> String {
+/// every tick when the axis spans less than a decade (few ticks),
+/// otherwise only 1, 2 and 5 times a power of ten, so labels never crowd.
+pub fn tick(v: f64, range: (f64, f64)) -> String {
     let mantissa = v / 10f64.powf(v.log10().floor());
-    let round = [1.0, 2.0, 5.0].iter().any(|m| (mantissa - m).abs() < 1e-6);
+    let round = [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .any(|m| (mantissa - m).abs() < 1e-6);
     if range.1 < 10.0 * range.0 || round {
-        format(v)
+        number(v)
     } else {
         String::new()
     }
+}
+
+/// `v` as a plot's reader expects it: to three significant digits
+/// without trailing zeros (0.01, 0.25, 1, 10, 2000), and as a power of
+/// ten (3·10⁻⁶, 10⁷) outside 0.0001-999,999, where decimals get long.
+pub fn number(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let exponent = v.abs().log10().floor() as i32;
+    if (-4..6).contains(&exponent) {
+        let decimals = (2 - exponent).max(0) as usize;
+        let s = format!("{v:.decimals$}");
+        let s = if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.')
+        } else {
+            &s
+        };
+        return s.to_string();
+    }
+    // Rounding may carry the mantissa to 10 (9.996e-7 is 10⁻⁶).
+    let (mut mantissa, mut exponent) = (v / 10f64.powi(exponent), exponent);
+    if (mantissa.abs() * 100.0).round() >= 1000.0 {
+        (mantissa, exponent) = (mantissa / 10.0, exponent + 1);
+    }
+    let power = format!("10{}", superscript(exponent));
+    if (mantissa - 1.0).abs() < 0.005 {
+        power
+    } else {
+        format!("{}·{power}", number(mantissa))
+    }
+}
+
+/// `n` in superscript digits (⁻¹²).
+fn superscript(n: i32) -> String {
+    const DIGITS: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+    let digits = n.unsigned_abs().to_string();
+    let sign = if n < 0 { "⁻" } else { "" };
+    sign.chars()
+        .chain(digits.bytes().map(|b| DIGITS[usize::from(b - b'0')]))
+        .collect()
 }
 
 /// One log-log chart on `area`: `caption`, the axes' descriptions and
@@ -93,7 +135,7 @@ fn log_log_chart<DB: DrawingBackend>(
 ) -> Result<(), String> {
     let err = |e: &dyn std::fmt::Display| e.to_string();
     let mut chart = ChartBuilder::on(area)
-        .caption(caption, ("sans-serif", 18))
+        .caption(caption, ("sans-serif", 21))
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(76)
@@ -114,8 +156,10 @@ fn log_log_chart<DB: DrawingBackend>(
         .y_desc(y_desc)
         // plotters' log axes crowd their minor grid lines near 1.
         .light_line_style(TRANSPARENT)
-        .x_label_formatter(&|v| tick(*v, x, |v| format!("{v:.3}")))
-        .y_label_formatter(&|v| tick(*v, y, |v| format!("{v:.1e}")))
+        .axis_desc_style(("sans-serif", 17))
+        .label_style(("sans-serif", 16))
+        .x_label_formatter(&|v| tick(*v, x))
+        .y_label_formatter(&|v| tick(*v, y))
         .draw()
         .map_err(|e| err(&e))?;
     for (i, (label, points)) in lines.iter().enumerate() {
@@ -135,9 +179,7 @@ fn log_log_chart<DB: DrawingBackend>(
     chart
         .configure_series_labels()
         .position(SeriesLabelPosition::LowerLeft)
-        // plotters sizes the legend box from its own estimate of the text
-        // (0.455 em per character): 18 px fits the PNG's pixel font.
-        .label_font(("sans-serif", 18))
+        .label_font(("sans-serif", 17))
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .draw()

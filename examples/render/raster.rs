@@ -1,6 +1,6 @@
-//! An 8-bit RGB canvas with a built-in 3x5 pixel font, and a `plotters`
-//! backend drawing into a rectangle of it: the comparison sheet and the
-//! PNG plots need no font files and no system fonts.
+//! An 8-bit RGB canvas, and a `plotters` backend drawing into a rectangle
+//! of it with anti-aliased text (`text.rs`): the comparison sheet and the
+//! PNG plots need no system fonts.
 
 use plotters_backend::text_anchor::{HPos, VPos};
 use plotters_backend::{
@@ -41,13 +41,20 @@ impl Canvas {
         }
     }
 
-    /// Draws `s` in white at `(x0, y0)`, `scale` canvas pixels per font
-    /// pixel, clipped at `x_end`.
-    pub fn text(&mut self, x0: usize, y0: usize, x_end: usize, scale: usize, s: &str) {
-        for (x, y) in text_pixels(s, scale) {
-            let (x, y) = (x0 + x as usize, y0 + y as usize);
-            if x < x_end {
-                self.blend(x as i64, y as i64, [255; 3], 1.0);
+    /// Draws `s` in `rgb` with its box's top-left corner at `(x0, y0)`,
+    /// an em of `size` pixels, clipped at `x_end`.
+    pub fn text(
+        &mut self,
+        (x0, y0): (usize, usize),
+        x_end: usize,
+        size: f32,
+        rgb: [u8; 3],
+        s: &str,
+    ) {
+        for (x, y, c) in crate::text::coverage(s, size) {
+            let x = x0 as i64 + i64::from(x);
+            if x < x_end as i64 {
+                self.blend(x, y0 as i64 + i64::from(y), rgb, f64::from(c));
             }
         }
     }
@@ -58,41 +65,15 @@ impl Canvas {
     }
 }
 
-/// The pixels `s` covers at `scale`, relative to its top-left corner:
-/// each character is a 4x6 cell (3x5 glyph and a gap), upper-cased.
-fn text_pixels(s: &str, scale: usize) -> impl Iterator<Item = (i32, i32)> + '_ {
-    s.chars().enumerate().flat_map(move |(i, c)| {
-        let g = glyph(c);
-        (0..5).flat_map(move |row| {
-            (0..3)
-                .filter(move |col| g[row] & (4 >> col) != 0)
-                .flat_map(move |col| {
-                    (0..scale * scale).map(move |k| {
-                        let x = (i * 4 + col) * scale + k % scale;
-                        let y = row * scale + k / scale;
-                        (x as i32, y as i32)
-                    })
-                })
-        })
-    })
-}
-
-/// The size in canvas pixels of `s` at `scale`.
-fn text_size(s: &str, scale: usize) -> (u32, u32) {
-    let n = s.chars().count();
-    (
-        (n * 4).saturating_sub(1) as u32 * scale as u32,
-        5 * scale as u32,
-    )
-}
-
-/// The font scale for a `plotters` font size in pixels.
-fn scale_for(size: f64) -> usize {
-    (size / 8.0).round().clamp(1.0, 4.0) as usize
+/// The em in pixels of a `plotters` font size: plotters' fonts and its
+/// SVG backend take a size to be 1.24 ems, so the PNG's text is as large
+/// as the SVG's.
+fn em(size: f64) -> f32 {
+    (size / 1.24) as f32
 }
 
 /// A `plotters` backend drawing into the rectangle `origin`, `size` of a
-/// [`Canvas`], text in the built-in font.
+/// [`Canvas`], text in DejaVu Sans.
 pub struct Viewport<'a> {
     canvas: &'a mut Canvas,
     origin: (i64, i64),
@@ -161,8 +142,8 @@ impl DrawingBackend for Viewport<'_> {
         if colour.alpha == 0.0 {
             return Ok(());
         }
-        let scale = scale_for(style.size());
-        let (w, h) = text_size(text, scale);
+        let size = em(style.size());
+        let (w, h) = crate::text::measure(text, size);
         let (w, h) = (w as i32, h as i32);
         let dx = match style.anchor().h_pos {
             HPos::Left => 0,
@@ -175,8 +156,12 @@ impl DrawingBackend for Viewport<'_> {
             VPos::Bottom => -h,
         };
         let transform = style.transform();
-        for (x, y) in text_pixels(text, scale) {
+        for (x, y, c) in crate::text::coverage(text, size) {
             let (x, y) = transform.transform(x + dx, y + dy);
+            let colour = BackendColor {
+                alpha: colour.alpha * f64::from(c),
+                rgb: colour.rgb,
+            };
             self.draw_pixel((pos.0 + x, pos.1 + y), colour)?;
         }
         Ok(())
@@ -187,58 +172,6 @@ impl DrawingBackend for Viewport<'_> {
         text: &str,
         style: &S,
     ) -> Result<(u32, u32), DrawingErrorKind<NoError>> {
-        Ok(text_size(text, scale_for(style.size())))
-    }
-}
-
-/// Glyph rows, top to bottom, bit 2 = left column.
-fn glyph(c: char) -> [u8; 5] {
-    match c.to_ascii_uppercase() {
-        'A' => [2, 5, 7, 5, 5],
-        'B' => [6, 5, 6, 5, 6],
-        'C' => [3, 4, 4, 4, 3],
-        'D' => [6, 5, 5, 5, 6],
-        'E' => [7, 4, 6, 4, 7],
-        'F' => [7, 4, 6, 4, 4],
-        'G' => [3, 4, 5, 5, 3],
-        'H' => [5, 5, 7, 5, 5],
-        'I' => [7, 2, 2, 2, 7],
-        'J' => [1, 1, 1, 5, 2],
-        'K' => [5, 5, 6, 5, 5],
-        'L' => [4, 4, 4, 4, 7],
-        'M' => [5, 7, 7, 5, 5],
-        'N' => [6, 5, 5, 5, 5],
-        'O' => [2, 5, 5, 5, 2],
-        'P' => [6, 5, 6, 4, 4],
-        'Q' => [2, 5, 5, 6, 3],
-        'R' => [6, 5, 6, 5, 5],
-        'S' => [3, 4, 2, 1, 6],
-        'T' => [7, 2, 2, 2, 2],
-        'U' => [5, 5, 5, 5, 7],
-        'V' => [5, 5, 5, 5, 2],
-        'W' => [5, 5, 7, 7, 5],
-        'X' => [5, 5, 2, 5, 5],
-        'Y' => [5, 5, 2, 2, 2],
-        'Z' => [7, 1, 2, 4, 7],
-        '0' => [7, 5, 5, 5, 7],
-        '1' => [2, 6, 2, 2, 7],
-        '2' => [6, 1, 2, 4, 7],
-        '3' => [6, 1, 2, 1, 6],
-        '4' => [5, 5, 7, 1, 1],
-        '5' => [7, 4, 6, 1, 6],
-        '6' => [3, 4, 6, 5, 2],
-        '7' => [7, 1, 2, 2, 2],
-        '8' => [2, 5, 2, 5, 2],
-        '9' => [2, 5, 3, 1, 6],
-        '.' => [0, 0, 0, 0, 2],
-        '-' => [0, 0, 7, 0, 0],
-        ':' => [0, 2, 0, 2, 0],
-        '=' => [0, 7, 0, 7, 0],
-        '+' => [0, 2, 7, 2, 0],
-        '%' => [5, 1, 2, 4, 5],
-        '/' => [1, 1, 2, 4, 4],
-        '(' => [1, 2, 2, 2, 1],
-        ')' => [4, 2, 2, 2, 4],
-        _ => [0; 5],
+        Ok(crate::text::measure(text, em(style.size())))
     }
 }

@@ -171,6 +171,73 @@ pub fn to_json(records: &[Record]) -> String {
     out
 }
 
+/// Reads records back from [`to_json`]'s output (`--replot`).
+pub fn from_json(text: &str) -> Result<Vec<Record>, String> {
+    let crate::json::Json::Array(items) = crate::json::parse(text)? else {
+        return Err("JSON: the records are not an array".into());
+    };
+    items
+        .iter()
+        .enumerate()
+        .map(|(i, item)| {
+            let missing = |k: &str| format!("JSON record {i}: no {k:?}");
+            let text = |k: &str| match item.get(k) {
+                Some(crate::json::Json::String(s)) => Ok(s.clone()),
+                _ => Err(missing(k)),
+            };
+            let num = |k: &str| {
+                item.get(k)
+                    .and_then(crate::json::Json::number)
+                    .ok_or_else(|| missing(k))
+            };
+            let int = |k: &str| num(k).map(|x| x as u64);
+            let curve = match item.get("curve") {
+                Some(crate::json::Json::Array(points)) => points
+                    .iter()
+                    .map(|p| {
+                        let n = |k: &str| {
+                            p.get(k)
+                                .and_then(crate::json::Json::number)
+                                .ok_or_else(|| missing(k))
+                        };
+                        Ok(CurvePoint {
+                            seconds: n("seconds")?,
+                            spp: n("spp")? as u64,
+                            relmse: n("relmse")?,
+                            bytes: n("bytes")? as usize,
+                        })
+                    })
+                    .collect::<Result<_, String>>()?,
+                _ => return Err(missing("curve")),
+            };
+            Ok(Record {
+                scene: text("scene")?,
+                method: text("method")?,
+                sigma: num("sigma")?,
+                width: int("width")? as u32,
+                height: int("height")? as u32,
+                spp: int("spp")?,
+                spp_final: int("spp_final")?,
+                seconds: num("seconds")?,
+                rmse: num("rmse")?,
+                relmse: num("relmse")?,
+                efficiency: num("efficiency")?,
+                rmse_raw: num("rmse_raw")?,
+                relmse_raw: num("relmse_raw")?,
+                reference_relmse: num("reference_relmse")?,
+                mean: num("mean")?,
+                mean_error: num("mean_error")?,
+                reference_mean: num("reference_mean")?,
+                sdtree_bytes: int("sdtree_bytes")? as usize,
+                glt_bytes: int("glt_bytes")? as usize,
+                emitters: int("emitters")? as usize,
+                iterations: int("iterations")? as u32,
+                curve,
+            })
+        })
+        .collect()
+}
+
 /// Efficiency of `r` relative to the method `base` of the same scene.
 fn relative(records: &[Record], r: &Record, base: &str) -> String {
     records

@@ -1,7 +1,6 @@
 //! The side-by-side comparison sheet: the reference and every method's
-//! tone-mapped image in a grid, each labelled with its name, RMSE and spp
-//! in the built-in font, with a chart (the convergence curves) beside
-//! them.
+//! tone-mapped image in a grid, each labelled with its name, RMSE and spp,
+//! with a chart (the convergence curves) beside them.
 
 use crate::film::tone_map;
 use crate::raster::{Canvas, Viewport};
@@ -12,15 +11,17 @@ use std::path::Path;
 pub struct Panel<'a> {
     /// Linear RGB.
     pub image: &'a [Vec3],
-    /// Label lines (upper-cased when drawn).
+    /// Label lines.
     pub lines: Vec<String>,
 }
 
 /// Draws a chart into the viewport it is given.
 pub type Chart<'a> = &'a dyn Fn(Viewport<'_>) -> Result<(), String>;
 
-const SCALE: usize = 2;
-const LINE: usize = 6 * SCALE + 2;
+/// The labels' em size in pixels.
+const FONT: f32 = 14.0;
+/// The labels' line height in pixels.
+const LINE: usize = 18;
 
 /// Writes the panels (each `width x height`) as a grid of at most four
 /// columns, tone mapped with `exposure`, and `chart` (if any) in a column
@@ -53,7 +54,8 @@ pub fn write_sheet(
             canvas.px[o..o + 3 * w].copy_from_slice(src);
         }
         for (k, line) in p.lines.iter().enumerate() {
-            canvas.text(x0 + 2, y0 + h + 3 + k * LINE, x0 + w, SCALE, line);
+            let at = (x0 + 2, y0 + h + 2 + k * LINE);
+            canvas.text(at, x0 + w, FONT, [235; 3], line);
         }
     }
     if let Some(draw) = chart {
