@@ -184,6 +184,14 @@ pub struct Args {
     /// as rendering time.
     #[arg(long)]
     pub no_curve: bool,
+    /// Render in tile order (each 16x16 tile to completion, in Morton
+    /// order, as pbrt-v3 and rs_pbrt do; needs --spp, draws no curves)
+    /// with the guided methods refining by this rule: `never`,
+    /// `doubling` (after 1, 3, 7, ... passes' worth of paths) or
+    /// `every-wave` (after every wave of tiles). Without it: pass order
+    /// (one sample per pixel per pass, PPG's iterations).
+    #[arg(long, value_name = "RULE", value_parser = crate::tiles::Refinement::parse)]
+    pub tiles: Option<crate::tiles::Refinement>,
     /// Move the camera by `x,y,z` (the next frame of a camera move).
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub camera_shift: Option<Vec<f32>>,

@@ -37,6 +37,7 @@ mod scene;
 mod scenes;
 mod sheet;
 mod text;
+mod tiles;
 
 use clap::Parser;
 use guiding::spatial::SpatialFilter;
@@ -294,6 +295,8 @@ fn run_scene(
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let mut records = Vec::new();
     let mut rendered = Vec::new();
+    // Tile order renders no curves.
+    let no_curve = args.no_curve || args.tiles.is_some();
     // The sigma study: GLT methods once per sigma.
     let study = args.sigma.len() > 1;
     let runs: Vec<(Method, Option<f64>)> = methods
@@ -326,12 +329,18 @@ fn run_scene(
                 bytes: c.bytes,
             });
         };
-        let observer: Option<&mut dyn FnMut(run::CurveSample<'_>)> = if args.no_curve {
+        let observer: Option<&mut dyn FnMut(run::CurveSample<'_>)> = if no_curve {
             None
         } else {
             Some(&mut observe)
         };
-        let r = run::render_observed(&scene, method, settings, observer).0;
+        let r = match (args.tiles, settings.budget) {
+            (None, _) => run::render_observed(&scene, method, settings, observer).0,
+            (Some(rule), Budget::Spp(spp)) => {
+                tiles::render_tiles(&scene, method, settings, spp, rule)
+            }
+            (Some(_), Budget::Seconds(_)) => return Err("--tiles renders --spp samples".into()),
+        };
         let e = metrics::errors(&r.image, &reference);
         write_outputs(&dir, &label.replace(' ', "-"), &r, exposure)?;
         records.push(Record {
@@ -382,7 +391,7 @@ fn run_scene(
         settings.height,
         exposure,
         &panels,
-        (!args.no_curve).then_some(&chart as sheet::Chart<'_>),
+        (!no_curve).then_some(&chart as sheet::Chart<'_>),
     )?;
     film::write_png(
         &dir.join("reference.png"),
@@ -395,7 +404,7 @@ fn run_scene(
         dir.display(),
         sheet_path.display()
     );
-    if !args.no_curve {
+    if !no_curve {
         let [svg, png] = plot::convergence(&dir.join("convergence"), name, &records)?;
         println!(
             "{name}: convergence plot (relMSE over time) {} and {}",

@@ -497,7 +497,7 @@ pub fn render_observed<'a>(
 }
 
 /// Mean luminance of an RGB buffer.
-fn mean_luminance(rgb: &[f32]) -> f64 {
+pub fn mean_luminance(rgb: &[f32]) -> f64 {
     let n = (rgb.len() / 3).max(1) as f64;
     rgb.chunks_exact(3)
         .map(|c| f64::from(luminance(Vec3::from_slice(c))))
