@@ -1650,3 +1650,77 @@ fn a_light_without_power_has_pmf_zero() {
         }
     }
 }
+
+/// Each importance rule alone changes the light choice, and a configuration
+/// with none of them pays for no importance table: the table is built only
+/// when `CutConfig::uses_importance` says a rule needs it, so a rule left
+/// without it would fall back to power silently. And the two rule
+/// builders set all three rules.
+#[test]
+fn each_importance_rule_works_alone_and_only_they_pay_for_the_table() {
+    let at = |i: u32| Vec3::new(2.0 * i as f32, 1.0, 0.0);
+    let lights: Vec<Emitter> = (0..16)
+        .map(|i| Emitter::point(at(i), 1.0 + (i % 3) as f32))
+        .collect();
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    // A coarse cut (sigma 0.3), so that below it matters too.
+    let paper = CutConfig {
+        sigma: 0.3,
+        ..CutConfig::default().with_paper_rules()
+    };
+    let rules = |c: CutConfig| (c.modulation, c.below_cut, c.prior);
+    assert_eq!(
+        rules(paper),
+        (Modulation::None, BelowCut::Power, Prior::Power)
+    );
+    let all = paper.with_importance();
+    let importance = (
+        Modulation::Importance,
+        BelowCut::Importance,
+        Prior::Importance,
+    );
+    assert_eq!(rules(all), importance);
+    assert_eq!(rules(CutConfig::default()), importance);
+    // Trained from the left end (x = 0), evaluated at the right end.
+    let learned = |config: CutConfig| {
+        let guide = CutRules::new(&tree, config).unwrap();
+        let cut = guide.new_cut();
+        for k in 0..4000u32 {
+            let e = k % 16;
+            let value = 1.0 / (1.0 + at(e).length_squared());
+            guide.splat_from(&cut, Vec3::ZERO, LightId::Emitter(e), value);
+        }
+        let mut cut = cut;
+        assert!(guide.refine(&mut cut));
+        let ctx = ShadingContext::at(Vec3::new(30.0, 0.0, 0.0));
+        let pmf: Vec<f64> = (0..16)
+            .map(|e| guide.pmf_exact(&cut, &ctx, LightId::Emitter(e)))
+            .collect();
+        (pmf, guide.bytes())
+    };
+    let (base, base_bytes) = learned(paper);
+    for one in [
+        CutConfig {
+            modulation: Modulation::Importance,
+            ..paper
+        },
+        CutConfig {
+            below_cut: BelowCut::Importance,
+            ..paper
+        },
+        CutConfig {
+            prior: Prior::Importance,
+            ..paper
+        },
+        all,
+    ] {
+        let (pmf, bytes) = learned(one);
+        let moved: f64 = pmf.iter().zip(&base).map(|(a, b)| (a - b).abs()).sum();
+        assert!(moved > 0.01, "{:?} moves the pmf by {moved}", rules(one));
+        assert!(
+            bytes > base_bytes,
+            "{:?}: {bytes} bytes, paper {base_bytes}",
+            rules(one)
+        );
+    }
+}

@@ -329,11 +329,8 @@ fn run_scene(
                 bytes: c.bytes,
             });
         };
-        let observer: Option<&mut dyn FnMut(run::CurveSample<'_>)> = if no_curve {
-            None
-        } else {
-            Some(&mut observe)
-        };
+        let observer: Option<&mut dyn FnMut(run::CurveSample<'_>)> =
+            if no_curve { None } else { Some(&mut observe) };
         let r = match (args.tiles, settings.budget) {
             (None, _) => run::render_observed(&scene, method, settings, observer).0,
             (Some(rule), Budget::Spp(spp)) => {
