@@ -408,7 +408,36 @@ fn memory_report_adds_up() {
         m.total(),
         m.spatial_bytes + m.shared_bytes + m.cuts.node_bytes + m.cuts.sum_bytes
     );
-    assert!(m.bytes_per_cell() > 0.0);
+    let per_cell = (m.total() - m.shared_bytes) as f64 / m.cells as f64;
+    assert_eq!(m.bytes_per_cell(), per_cell);
+    assert!(per_cell > 12.0 * m.cuts.nodes as f64 / m.cells as f64);
+}
+
+/// One refinement splits a cell as many levels deep as its count allows,
+/// each half taken to have half its parent's splats (PPG's rule): 1,000
+/// splats at threshold 100 split the root while the count is above it
+/// (1,000, 500, 250, 125; not 62), 4 levels, 1 + 2 + 4 + 8 = 15 splits.
+#[test]
+fn one_refinement_splits_as_deep_as_the_count_allows() {
+    let lights = two_rooms();
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let config = GltConfig {
+        spatial_threshold: 100.0,
+        ..GltConfig::default()
+    };
+    let mut glt = Glt::new(&tree, scene(), config).unwrap();
+    for _ in 0..1000 {
+        glt.splat_at(Vec3::new(-9.0, -9.0, -9.0), LightId::Emitter(3), 2.0);
+    }
+    let out = glt.refine();
+    assert_eq!((out.splits, out.refused_by_budget), (15, 0));
+    assert_eq!(glt.spatial().cell_count(), 16);
+    // The next refinement's threshold is 100 sqrt(2) = 141.4: 142 splats
+    // in one cell split it once more, its halves' 71 do not split them.
+    for _ in 0..142 {
+        glt.splat_at(Vec3::new(-9.0, -9.0, -9.0), LightId::Emitter(3), 2.0);
+    }
+    assert_eq!(glt.refine().splits, 1);
 }
 
 /// A renderer keeps its lights and its guiding state in one struct: the GLT
