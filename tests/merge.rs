@@ -281,3 +281,56 @@ fn mismatched_merges_are_refused() {
     sd2.refine();
     assert!(!sd.merge(&sd2));
 }
+
+/// Copies whose cuts would sample differently refuse to merge even where
+/// their cut nodes are equal: other learned fractions of the unbounded
+/// lights, other learned visibilities. A true copy merges.
+#[test]
+fn cuts_with_equal_nodes_that_sample_differently_refuse_to_merge() {
+    let config = GltConfig {
+        // One cell: only the cuts can differ.
+        spatial_threshold: 1e12,
+        cut: CutConfig {
+            unbounded: guiding::UnboundedLights {
+                count: 1,
+                probability: 0.1,
+            },
+            visibility: true,
+            ..CutConfig::default()
+        },
+        ..GltConfig::default()
+    };
+    let n = two_rooms().len() as u32;
+    // The same emitter records; the sky's value and the share of the
+    // emitters' records that were shadowed vary.
+    let learned = |sky: f32, shadowed: u32| {
+        let mut glt = Glt::new(tree(), scene(), config).unwrap();
+        for k in 0..4000u32 {
+            let p = Vec3::new(-4.0, 0.0, 1.0);
+            let light = LightId::Emitter(k % n);
+            glt.splat_at(p, light, 1.0);
+            let seen = if k % 8 < shadowed { 0.0 } else { 1.0 };
+            glt.splat_visibility(p, light, seen, 1.0);
+            glt.splat_at(p, LightId::Unbounded(0), sky);
+        }
+        glt.refine();
+        glt
+    };
+    let a = learned(1.0, 0);
+    let cut = |g: &Glt<&LightTree>| g.spatial().data_slice()[0].cut().clone();
+    for (b, what) in [
+        (learned(3.0, 0), "sky fraction"),
+        (learned(1.0, 4), "visibility"),
+    ] {
+        assert_eq!(cut(&a).nodes(), cut(&b).nodes(), "{what}");
+        assert_ne!(
+            (cut(&a).unbounded_fractions(), cut(&a).visibility()),
+            (cut(&b).unbounded_fractions(), cut(&b).visibility()),
+            "{what}"
+        );
+        let mut merged = a.clone();
+        assert!(!merged.merge(&b), "{what}");
+        assert_eq!(merged.to_bytes(), a.to_bytes(), "{what}");
+    }
+    assert!(a.clone().merge(&learned(1.0, 0)));
+}
