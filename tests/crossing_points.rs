@@ -5,6 +5,9 @@
 #[path = "../examples/render/crossing.rs"]
 #[allow(dead_code)]
 mod crossing;
+#[path = "../examples/render/json.rs"]
+#[allow(dead_code)]
+mod json;
 #[path = "../examples/render/report.rs"]
 #[allow(dead_code)]
 mod report;
