@@ -121,8 +121,12 @@ impl<H: LightHierarchy> CutRules<H> {
         } else {
             4 + 2 * per_sum
         };
+        // Slots: two per node, or the root's one when there is none.
+        let root_slot = usize::from(nodes == 0);
         Growth {
-            fixed: (1 + unbounded) * (per_sum + per_slot) + cut.anchor.bytes() + 4 * unbounded,
+            fixed: (root_slot + unbounded) * (per_sum + per_slot)
+                + cut.anchor.bytes()
+                + 4 * unbounded,
             nodes,
             per_node: CutNode::BYTES + 2 * (per_sum + per_slot),
         }
@@ -328,4 +332,110 @@ fn rebuild<H: LightHierarchy>(
         }
     }
     nodes
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emitter::Emitter;
+    use crate::glt::CutConfig;
+    use crate::light_sampler::{LightId, UnboundedLights};
+    use crate::light_tree::{BuildHeuristic, LightTree};
+    use glam::Vec3;
+
+    /// What [`CutRules::growth`] predicts is what the refinement builds:
+    /// the refined cut holds exactly `fixed + nodes * per_node` heap bytes,
+    /// for a fresh cut and one refined before, with and without unbounded
+    /// lights, learned visibility and the anchor (the memory budget splits
+    /// what is left between cells by these predictions).
+    #[test]
+    fn growth_predicts_the_refined_cut_exactly() {
+        let lights: Vec<Emitter> = (0..40)
+            .map(|i| Emitter::point(Vec3::new(i as f32, (i % 7) as f32, 0.0), 1.0 + i as f32))
+            .collect();
+        let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+        let rich = CutConfig {
+            visibility: true,
+            unbounded: UnboundedLights::new(2, 0.1).unwrap(),
+            ..CutConfig::default()
+        };
+        for config in [rich, CutConfig::default().with_paper_rules()] {
+            let guide = CutRules::new(&tree, config).unwrap();
+            let mut cut = guide.new_cut();
+            for round in 0..3u32 {
+                for k in 0..2000u32 {
+                    let e = (k * 7 + round) % 40;
+                    let l = LightId::Emitter(e);
+                    let p = Vec3::new(e as f32, 0.0, 1.0);
+                    guide.splat_from(&cut, p, l, 1.0 + (e * e) as f32);
+                    guide.splat_visibility(&cut, l, (e % 3) as f32 / 2.0, 1.0);
+                }
+                if config.unbounded.count > 0 {
+                    guide.splat(&cut, LightId::Unbounded(1), 50.0);
+                }
+                let g = guide.growth(&cut);
+                assert!(guide.refine(&mut cut), "round {round}");
+                assert_eq!(
+                    cut.heap_bytes(),
+                    g.fixed + g.nodes * g.per_node,
+                    "round {round}, {config:?}"
+                );
+                assert_eq!(g.nodes, cut.nodes.len());
+            }
+            assert!(cut.nodes.len() > 4, "the cut split");
+        }
+    }
+
+    /// Under a node cap the rebuild is redone with `sigma` doubled (from
+    /// `1 / (2 cap + 2)` when it is 0) until the cut fits: the capped cut
+    /// is the uncapped one at the first such `sigma` that fits.
+    #[test]
+    fn a_node_cap_doubles_sigma_until_the_cut_fits() {
+        let lights: Vec<Emitter> = (0..64)
+            .map(|i| Emitter::point(Vec3::new(i as f32, (i % 5) as f32, 0.0), 1.0))
+            .collect();
+        let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+        for sigma0 in [0.01, 0.0] {
+            let config = CutConfig {
+                sigma: sigma0,
+                ..CutConfig::default()
+            };
+            let guide = CutRules::new(&tree, config).unwrap();
+            let trained = guide.new_cut();
+            for k in 0..6000u32 {
+                let e = (k * 13) % 64;
+                guide.splat(&trained, LightId::Emitter(e), 1.0 + ((e * 7) % 11) as f32);
+            }
+            let refined_at = |sigma: f64| {
+                let rules = CutRules::new(&tree, CutConfig { sigma, ..config }).unwrap();
+                let mut c = trained.clone();
+                rules.refine(&mut c);
+                c.nodes
+            };
+            let uncapped = refined_at(sigma0).len();
+            assert!(uncapped > 8, "{uncapped}");
+            for cap in [0, 1, 3, 8, uncapped - 1, uncapped, uncapped + 5] {
+                let mut capped = trained.clone();
+                assert!(guide.refine_within(&mut capped, Some(cap)));
+                assert!(
+                    capped.nodes.len() <= cap,
+                    "cap {cap}: {}",
+                    capped.nodes.len()
+                );
+                let mut sigma = sigma0;
+                let expected = loop {
+                    let nodes = refined_at(sigma);
+                    if nodes.len() <= cap || sigma >= 1.0 {
+                        break nodes;
+                    }
+                    sigma = if sigma > 0.0 {
+                        (2.0 * sigma).min(1.0)
+                    } else {
+                        1.0 / (2 * cap + 2) as f64
+                    };
+                };
+                assert_eq!(capped.nodes, expected, "cap {cap}, sigma {sigma0}");
+            }
+        }
+    }
 }
