@@ -1724,3 +1724,46 @@ fn each_importance_rule_works_alone_and_only_they_pay_for_the_table() {
         );
     }
 }
+
+/// A refinement from records that carry nothing from emitters (only
+/// zeros, or only the unbounded lights') keeps the cut's nodes and says so
+/// (`false`); the unbounded lights' fractions follow what was collected
+/// (unchanged after zeros, all the sky's after only sky).
+#[test]
+fn a_cut_that_collected_nothing_from_emitters_keeps_its_nodes() {
+    let lights: Vec<Emitter> = (0..16)
+        .map(|i| Emitter::point(Vec3::new(i as f32, 0.0, 0.0), 1.0 + i as f32))
+        .collect();
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let config = CutConfig {
+        min_splats: 0,
+        unbounded: UnboundedLights::new(1, 0.1).unwrap(),
+        ..CutConfig::default()
+    };
+    let guide = CutRules::new(&tree, config).unwrap();
+    let mut cut = guide.new_cut();
+    for k in 0..800u32 {
+        guide.splat(&cut, LightId::Emitter(k % 16), 1.0 + (k % 16) as f32);
+    }
+    guide.splat(&cut, LightId::Unbounded(0), 40.0);
+    assert!(guide.refine(&mut cut));
+    let (nodes, fractions) = (cut.nodes().to_vec(), cut.unbounded_fractions().to_vec());
+    assert!(nodes.len() > 2 && fractions[0] > 0.0 && fractions[0] < 0.1);
+    for e in 0..16 {
+        guide.splat(&cut, LightId::Emitter(e), 0.0);
+    }
+    guide.splat(&cut, LightId::Unbounded(0), 0.0);
+    assert!(!guide.refine(&mut cut));
+    assert_eq!(
+        (cut.nodes(), cut.unbounded_fractions()),
+        (&nodes[..], &fractions[..])
+    );
+    for _ in 0..100 {
+        guide.splat(&cut, LightId::Unbounded(0), 2.0);
+    }
+    assert!(!guide.refine(&mut cut));
+    assert_eq!(
+        (cut.nodes(), cut.unbounded_fractions()),
+        (&nodes[..], &[1.0f32][..])
+    );
+}

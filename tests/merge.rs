@@ -334,3 +334,60 @@ fn cuts_with_equal_nodes_that_sample_differently_refuse_to_merge() {
     }
     assert!(a.clone().merge(&learned(1.0, 0)));
 }
+
+/// Fields that are not copies of one refuse to merge and stay as they
+/// were: another cut configuration, another light filter, another
+/// refinement, cuts with equal nodes that learned another sky fraction.
+/// A true copy merges.
+#[test]
+fn mismatched_fields_refuse_to_merge() {
+    let config = FieldConfig {
+        cut: CutConfig {
+            unbounded: guiding::UnboundedLights {
+                count: 1,
+                probability: 0.1,
+            },
+            ..CutConfig::default()
+        },
+        ..FieldConfig::default()
+    };
+    let learned = |config: FieldConfig, sky: f32, refine: bool| {
+        let mut field = GuidingField::new(tree(), scene(), config).unwrap();
+        let stream = samples(1, 3000);
+        for s in &stream {
+            field.record(s);
+        }
+        for s in stream.iter().take(50) {
+            let v = field.vertex(s.p).unwrap();
+            v.splat_light(LightId::Unbounded(0), sky, &mut JitterNumbers(s.jitter));
+        }
+        if refine {
+            field.refine();
+        }
+        field
+    };
+    let a = learned(config, 1.0, true);
+    let finer = FieldConfig {
+        cut: CutConfig {
+            sigma: 0.02,
+            ..config.cut
+        },
+        ..config
+    };
+    let jittered = FieldConfig {
+        light_filter: guiding::spatial::SpatialFilter::StochasticBox,
+        ..config
+    };
+    let others = [
+        (learned(finer, 1.0, true), "cut configuration"),
+        (learned(jittered, 1.0, true), "light filter"),
+        (learned(config, 1.0, false), "refinement"),
+        (learned(config, 5.0, true), "sky fraction"),
+    ];
+    for (b, what) in &others {
+        let mut merged = a.clone();
+        assert!(!merged.merge(b), "{what}");
+        assert_eq!(merged.to_bytes(), a.to_bytes(), "{what}");
+    }
+    assert!(a.clone().merge(&learned(config, 1.0, true)));
+}

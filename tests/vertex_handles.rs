@@ -214,3 +214,95 @@ fn field_vertex_equals_the_field_by_position() {
     let empty = GuidingField::new(&dark_tree, scene(), config).unwrap();
     assert!(empty.is_empty() && empty.vertex(Vec3::ZERO).unwrap().is_empty());
 }
+
+/// The records [`glt_vertex_drops_and_counts_bad_records_as_the_glt_does`]
+/// and its field twin make: `(light, value, unshadowed)`, good and bad.
+fn mixed_records(n: u32) -> [(LightId, f32, f32); 7] {
+    [
+        (LightId::Emitter(3), 1.0, 2.0),
+        (LightId::Emitter(3), f32::NAN, 2.0),
+        (LightId::Emitter(n + 5), 1.0, 2.0),
+        (LightId::Emitter(4), -1.0, 2.0),
+        (LightId::Emitter(4), 0.0, 2.0),
+        (LightId::Emitter(5), 3.0, 2.0),
+        (LightId::Unbounded(0), 1.0, 1.0),
+    ]
+}
+
+/// Of [`mixed_records`], dropped as splats: the NaN, the light out of
+/// range, the negative value, the sky the configuration does not have;
+/// as visibility records the same but the NaN (its record is
+/// `min(NaN, 2) = 2` of 2).
+const MIXED_DROPPED: u64 = 4 + 3;
+
+/// Bad records made through a GLT vertex are dropped and counted exactly as
+/// through the GLT by position, and good ones are not counted: light
+/// splats and visibility records alike.
+#[test]
+fn glt_vertex_drops_and_counts_bad_records_as_the_glt_does() {
+    let lights = two_rooms();
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let config = GltConfig {
+        cut: guiding::glt::CutConfig {
+            visibility: true,
+            ..Default::default()
+        },
+        ..GltConfig::default()
+    };
+    let (by_pos, by_vertex) = (
+        Glt::new(&tree, scene(), config).unwrap(),
+        Glt::new(&tree, scene(), config).unwrap(),
+    );
+    let p = Vec3::new(-3.0, 1.0, 2.0);
+    let v = by_vertex.vertex(p).unwrap();
+    let records = mixed_records(lights.len() as u32);
+    let mut rng = Pcg32::seed_from_u64(1);
+    for (k, &(light, value, unshadowed)) in records.iter().enumerate() {
+        let a = by_pos.splat(p, light, value, &mut rng);
+        assert_eq!(a, v.splat_light(light, value, &mut rng), "record {k}");
+        let seen = value.min(unshadowed);
+        let b = by_pos.splat_visibility(p, light, seen, unshadowed);
+        assert_eq!(b, v.splat_visibility(light, seen, unshadowed), "record {k}");
+        assert_eq!(
+            by_pos.dropped_splats(),
+            by_vertex.dropped_splats(),
+            "record {k}"
+        );
+    }
+    assert_eq!(by_pos.dropped_splats().light, MIXED_DROPPED);
+}
+
+/// The field's twin of [`glt_vertex_drops_and_counts_bad_records_as_the_glt_does`].
+#[test]
+fn field_vertex_drops_and_counts_bad_records_as_the_field_does() {
+    use guiding::field::{FieldConfig, GuidingField};
+    let lights = two_rooms();
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let config = FieldConfig {
+        cut: guiding::glt::CutConfig {
+            visibility: true,
+            ..Default::default()
+        },
+        ..FieldConfig::default()
+    };
+    let (by_pos, by_vertex) = (
+        GuidingField::new(&tree, scene(), config).unwrap(),
+        GuidingField::new(&tree, scene(), config).unwrap(),
+    );
+    let p = Vec3::new(-3.0, 1.0, 2.0);
+    let v = by_vertex.vertex(p).unwrap();
+    let mut rng = Pcg32::seed_from_u64(1);
+    for (k, &(light, value, unshadowed)) in mixed_records(lights.len() as u32).iter().enumerate() {
+        let a = by_pos.splat_light(p, light, value, &mut rng);
+        assert_eq!(a, v.splat_light(light, value, &mut rng), "record {k}");
+        let seen = value.min(unshadowed);
+        let b = by_pos.splat_visibility(p, light, seen, unshadowed);
+        assert_eq!(b, v.splat_visibility(light, seen, unshadowed), "record {k}");
+        assert_eq!(
+            by_pos.dropped_splats(),
+            by_vertex.dropped_splats(),
+            "record {k}"
+        );
+    }
+    assert_eq!(by_pos.dropped_splats().light, MIXED_DROPPED);
+}
