@@ -160,7 +160,9 @@ fn methods_agree_rendered(
     settings.budget = Budget::Spp(spp);
     settings.seed = 3;
     tweak(&mut settings.params);
-    let results: Vec<(Method, Vec<(f64, f64)>, bool)> = methods
+    // Each method's region means, and whether it refined.
+    type Means = Vec<(f64, f64)>;
+    let results: Vec<(Method, Means, bool)> = methods
         .iter()
         .map(|&m| {
             let r = render(&scene, m, &settings);
