@@ -348,28 +348,8 @@ pub fn render_observed<'a>(
                 }
                 bar.set_position((done * 1000.0) as u64);
             }
-            let lights: &(dyn LightSampler + Sync) = match (&fixed, &glt, &field) {
-                (Some(f), _, _) => f.as_ref(),
-                (None, Some(g), _) => g,
-                (None, None, Some(f)) => f,
-                (None, None, None) => unreachable!("every method has a light sampler"),
-            };
-            let guides = Guides {
-                lights,
-                glt: glt.as_ref(),
-                sd_tree: sd_tree.as_ref(),
-                field: field.as_ref(),
-                train: trained && !it.is_last,
-                contribution_splats: settings.params.contribution_splats,
-                resample_vertices: settings.params.resample_vertices,
-                nee_samples: settings.params.nee_samples.max(1),
-                nee_samples_vertices: settings.params.nee_samples_vertices,
-                resample: if fixed.is_none() {
-                    settings.params.resample
-                } else {
-                    0
-                },
-            };
+            let train = trained && !it.is_last;
+            let guides = guides(&fixed, &glt, &sd_tree, &field, &settings.params, train);
             render_pass(scene, &guides, settings, spp, &mut pass_buf);
             stats.add_pass(&pass_buf);
             let m = mean_luminance(&pass_buf);
@@ -416,15 +396,7 @@ pub fn render_observed<'a>(
         if it.is_last {
             break;
         }
-        if let Some(g) = glt.as_mut() {
-            g.refine();
-        }
-        if let Some(t) = sd_tree.as_mut() {
-            t.refine();
-        }
-        if let Some(f) = field.as_mut() {
-            f.refine();
-        }
+        refine(&mut glt, &mut sd_tree, &mut field);
         k += 1;
     }
     bar.finish_and_clear();
@@ -494,6 +466,53 @@ pub fn render_observed<'a>(
         field,
     };
     (rendered, learned)
+}
+
+/// What a path consults and trains with a method's samplers: its fixed
+/// light sampler, or the structures it trains (recording if `train`).
+pub fn guides<'r, 's: 'r>(
+    fixed: &'r Option<Box<dyn LightSampler + Sync + 's>>,
+    glt: &'r Option<Glt<&'s LightTree>>,
+    sd_tree: &'r Option<SdTree>,
+    field: &'r Option<GuidingField<&'s LightTree>>,
+    params: &GuideParams,
+    train: bool,
+) -> Guides<'r> {
+    let lights: &(dyn LightSampler + Sync) = match (fixed, glt, field) {
+        (Some(f), _, _) => f.as_ref(),
+        (None, Some(g), _) => g,
+        (None, None, Some(f)) => f,
+        (None, None, None) => unreachable!("every method has a light sampler"),
+    };
+    Guides {
+        lights,
+        glt: glt.as_ref(),
+        sd_tree: sd_tree.as_ref(),
+        field: field.as_ref(),
+        train,
+        contribution_splats: params.contribution_splats,
+        resample_vertices: params.resample_vertices,
+        nee_samples: params.nee_samples.max(1),
+        nee_samples_vertices: params.nee_samples_vertices,
+        resample: if fixed.is_none() { params.resample } else { 0 },
+    }
+}
+
+/// Refines whichever structures a method trains.
+pub fn refine(
+    glt: &mut Option<Glt<&LightTree>>,
+    sd_tree: &mut Option<SdTree>,
+    field: &mut Option<GuidingField<&LightTree>>,
+) {
+    if let Some(g) = glt.as_mut() {
+        g.refine();
+    }
+    if let Some(t) = sd_tree.as_mut() {
+        t.refine();
+    }
+    if let Some(f) = field.as_mut() {
+        f.refine();
+    }
 }
 
 /// Mean luminance of an RGB buffer.

@@ -10,13 +10,12 @@
 //! depend on the thread count (deterministic mode) and a refinement sees
 //! what a renderer's pool would have finished by then.
 
-use crate::integrator::{Guides, Recorder, radiance};
+use crate::integrator::{Recorder, radiance};
 use crate::methods::{Method, fixed_sampler, new_field, new_glt, new_sd_tree};
 use crate::rng::Sampler;
-use crate::run::{Rendered, Settings, mean_luminance};
+use crate::run::{Rendered, Settings, guides, mean_luminance, refine};
 use crate::scene::Scene;
 use glam::Vec3;
-use guiding::LightSampler;
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -123,28 +122,7 @@ pub fn render_tiles(
     // triggers the next `Doubling` refinement.
     let (mut samples, mut next_worth, mut refinements) = (0u64, 1u64, 0u32);
     for chunk in tiles.chunks(WAVE) {
-        let lights: &(dyn LightSampler + Sync) = match (&fixed, &glt, &field) {
-            (Some(f), _, _) => f.as_ref(),
-            (None, Some(g), _) => g,
-            (None, None, Some(f)) => f,
-            (None, None, None) => unreachable!("every method has a light sampler"),
-        };
-        let guides = Guides {
-            lights,
-            glt: glt.as_ref(),
-            sd_tree: sd_tree.as_ref(),
-            field: field.as_ref(),
-            train: learns,
-            contribution_splats: settings.params.contribution_splats,
-            resample_vertices: settings.params.resample_vertices,
-            nee_samples: settings.params.nee_samples.max(1),
-            nee_samples_vertices: settings.params.nee_samples_vertices,
-            resample: if fixed.is_none() {
-                settings.params.resample
-            } else {
-                0
-            },
-        };
+        let guides = guides(&fixed, &glt, &sd_tree, &field, &settings.params, learns);
         let rendered: Vec<Vec<Moments>> = chunk
             .par_iter()
             .map(|&(x0, y0)| {
@@ -187,7 +165,7 @@ pub fn render_tiles(
         if !learns {
             continue;
         }
-        let refine = match rule {
+        let refine_now = match rule {
             Refinement::Never => false,
             Refinement::EveryWave => true,
             Refinement::Doubling => {
@@ -198,16 +176,8 @@ pub fn render_tiles(
                 due
             }
         };
-        if refine {
-            if let Some(g) = glt.as_mut() {
-                g.refine();
-            }
-            if let Some(t) = sd_tree.as_mut() {
-                t.refine();
-            }
-            if let Some(f) = field.as_mut() {
-                f.refine();
-            }
+        if refine_now {
+            refine(&mut glt, &mut sd_tree, &mut field);
             refinements += 1;
         }
     }
