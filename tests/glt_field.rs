@@ -98,22 +98,26 @@ fn learns_per_region_and_keeps_the_contract() {
 }
 
 /// When a cell splits, both halves start from a copy of its cut and
-/// statistics, so before any new data they sample identically.
+/// statistics; the halves its records came from trust what it learned
+/// (confidence 1), the others, which no record reached, sample as the
+/// prior does (confidence 0) until records of their own arrive.
 #[test]
-fn split_cells_inherit_the_cut() {
+fn split_cells_inherit_the_cut_where_its_records_came_from() {
     let lights = two_rooms();
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
-    // The paper's rules: one distribution per cell, so equal cuts give equal
-    // pmfs anywhere.
+    // The paper's rules: one distribution per cell, so equal cuts and
+    // confidences give equal pmfs anywhere.
     let config = GltConfig {
         spatial_threshold: 100.0,
         cut: CutConfig::default().with_paper_rules(),
         ..GltConfig::default()
     };
-    let mut glt = Glt::new(&tree, scene(), config).unwrap();
+    let prior = Glt::new(&tree, scene(), config).unwrap();
+    let mut glt = prior.clone();
     // All splats in one corner, all for light 3: the root cell splits; its
     // halves refine from the same sums.
     let p = Vec3::new(-9.0, -9.0, -9.0);
+    let near = ShadingContext::at(p);
     let far = ShadingContext::at(Vec3::new(9.0, 9.0, 9.0));
     for _ in 0..1000 {
         glt.splat_at(p, LightId::Emitter(3), 2.0);
@@ -127,24 +131,29 @@ fn split_cells_inherit_the_cut() {
         assert_eq!(cell.cut().nodes(), &first[..]);
         assert_eq!(cell.splats(), 0);
     }
-    let near = ShadingContext::at(p);
+    let at = |glt: &Glt<&LightTree>, ctx: &ShadingContext| {
+        let cell = glt.locate(ctx.position).unwrap();
+        glt.spatial().data(cell).cut().confidence()
+    };
+    assert_eq!((at(&glt, &near), at(&glt, &far)), (1.0, 0.0));
+    let alpha = glt.config().cut.alpha;
     let p3 = glt.pmf_exact(&near, LightId::Emitter(3));
-    assert_eq!(
-        p3.to_bits(),
-        glt.pmf_exact(&far, LightId::Emitter(3)).to_bits()
-    );
-    // A second round in the corner: that cell learns light 3 alone, the far
-    // one (no data) keeps its cut.
+    assert!(p3 > 1.0 - alpha, "{p3}");
+    for e in 0..lights.len() as u32 {
+        let l = LightId::Emitter(e);
+        let (learned, untrained) = (glt.pmf_exact(&far, l), prior.pmf_exact(&far, l));
+        assert!((learned - untrained).abs() <= 1e-12 * untrained, "light {e}");
+    }
+    // A round at the far corner: that cell learns from its own records.
+    let q = far.position;
     for _ in 0..1000 {
-        glt.splat_at(p, LightId::Emitter(3), 2.0);
+        glt.splat_at(q, LightId::Emitter(60), 2.0);
     }
     glt.refine();
-    let alpha = glt.config().cut.alpha;
-    assert!(glt.pmf_exact(&near, LightId::Emitter(3)) > 1.0 - alpha);
-    assert_eq!(
-        glt.pmf_exact(&far, LightId::Emitter(3)).to_bits(),
-        p3.to_bits()
-    );
+    assert_eq!(at(&glt, &far), 1.0);
+    assert!(glt.pmf_exact(&far, LightId::Emitter(60)) > 1.0 - alpha);
+    // The corner cell saw nothing new: it keeps what it learned.
+    assert_eq!(glt.pmf_exact(&near, LightId::Emitter(3)).to_bits(), p3.to_bits());
 }
 
 /// The stochastic box: splats near a cell border land on both sides, in

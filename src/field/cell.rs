@@ -1,15 +1,21 @@
 //! What one cell of the guiding field holds.
 
-use crate::glt::GuidingCut;
+use crate::glt::{GuidingCut, split_octants};
+use crate::math::Counter;
 use crate::sd_tree::SdCell;
 
 /// One cell of a [`GuidingField`](super::GuidingField): an SD-tree cell
 /// (directional quadtree, statistical weight, BSDF sampling fraction) and a
-/// guiding cut. A spatial split gives both children a copy of both.
+/// guiding cut. A spatial split gives both children a copy of both, each
+/// cut trusted as far as the light splats it learned from fell in that
+/// child ([`GuidingCut::confidence`]).
 #[derive(Clone, Debug)]
 pub struct FieldCell {
     pub(super) sd: SdCell,
     pub(super) cut: GuidingCut,
+    /// Light splats since the last refinement per octant of the cell (as
+    /// [`GltCell`](crate::glt::GltCell) counts them).
+    pub(super) octants: [Counter; 8],
 }
 
 impl FieldCell {
@@ -23,6 +29,43 @@ impl FieldCell {
     #[inline]
     pub fn cut(&self) -> &GuidingCut {
         &self.cut
+    }
+
+    /// A cell with `sd` and `cut`, no light splat counted.
+    pub(super) fn new(sd: SdCell, cut: GuidingCut) -> Self {
+        Self::with_counts(sd, cut, [0; 8])
+    }
+
+    /// A cell with `sd`, `cut` and the light splats counted per octant.
+    pub(super) fn with_counts(sd: SdCell, cut: GuidingCut, octants: [u64; 8]) -> Self {
+        Self {
+            sd,
+            cut,
+            octants: octants.map(Counter::with),
+        }
+    }
+
+    /// Light splats since the last refinement, per octant of the cell.
+    pub fn octant_splats(&self) -> [u64; 8] {
+        core::array::from_fn(|o| self.octants[o].get())
+    }
+
+    /// Splits the light splats' counts between this cell (the lower half
+    /// along `axis`) and `upper`, a copy of it, scaling each cut's
+    /// confidence by its half's share.
+    pub(super) fn share_split(&mut self, upper: &mut Self, axis: usize) {
+        let [(lower, lower_factor), (up, up_factor)] = split_octants(self.octant_splats(), axis);
+        self.octants = lower.map(Counter::with);
+        self.cut.confidence *= lower_factor;
+        upper.octants = up.map(Counter::with);
+        upper.cut.confidence *= up_factor;
+    }
+
+    /// Zeroes the light splat counts.
+    pub(super) fn reset_counts(&mut self) {
+        for c in &mut self.octants {
+            c.reset();
+        }
     }
 
     /// Bytes the cell owns on the heap: the quadtree's copies, the SD sums

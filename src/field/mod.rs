@@ -110,7 +110,7 @@ pub use vertex::FieldVertex;
 use crate::dropped::{DropReason, DroppedSplats};
 use crate::emitter::ShadingContext;
 use crate::error::Error;
-use crate::glt::{CutRules, SplatOutcome};
+use crate::glt::{CutRules, SplatOutcome, octant_of};
 use crate::light_sampler::{LightId, LightSample, LightSampler};
 use crate::light_tree::LightHierarchy;
 use crate::math::Aabb;
@@ -144,10 +144,7 @@ impl<H: LightHierarchy> GuidingField<H> {
         config.validate()?;
         let guide = CutRules::new(lights, config.cut)?;
         let sd = SdState::new(config.sd);
-        let cell = FieldCell {
-            sd: sd.new_cell(),
-            cut: guide.new_cut(),
-        };
+        let cell = FieldCell::new(sd.new_cell(), guide.new_cut());
         Ok(Self {
             cells: BinaryTree::new(scene, cell)?,
             sd,
@@ -187,15 +184,23 @@ impl<H: LightHierarchy> GuidingField<H> {
     /// zeroed. Returns what the spatial pass did.
     pub fn refine(&mut self) -> RefineOutcome {
         let guide = &self.guide;
-        self.sd.refine(
+        let outcome = self.sd.refine(
             &mut self.cells,
             |cell| guide.growth(&cell.cut),
             |cell, scale| {
                 let cap = scale.and_then(|_| guide.growth(&cell.cut).cap(scale));
-                guide.refine_within(&mut cell.cut, cap);
+                if guide.refine_within(&mut cell.cut, cap) {
+                    // Learned from the cell's own light splats.
+                    cell.cut.confidence = 1.0;
+                }
             },
+            FieldCell::share_split,
             FieldCell::heap_bytes,
-        )
+        );
+        for cell in self.cells.data_slice_mut() {
+            cell.reset_counts();
+        }
+        outcome
     }
 
     /// The configuration.
@@ -255,9 +260,12 @@ impl<H: LightHierarchy> GuidingField<H> {
         value: f32,
         filter: (SpatialFilter, impl FnOnce() -> Vec3),
     ) -> SplatOutcome {
+        let octant = at.map_or(0, |(_, bounds)| octant_of(p, &bounds));
         let outcome = self
             .guide
-            .splat_spread(&self.cells, (p, at), light, value, filter, |_| {});
+            .splat_spread(&self.cells, (p, at), light, value, filter, |cell| {
+                cell.octants[octant].bump();
+            });
         if outcome == SplatOutcome::Dropped {
             self.sd.dropped.count(DropReason::Light);
         }

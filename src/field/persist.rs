@@ -25,6 +25,10 @@ impl<H: LightHierarchy> GuidingField<H> {
         self.cells.write(&mut w, |cell, w| {
             cell.sd.write(w);
             cell.cut.write(w);
+            // Version 3: the light splats per octant.
+            for n in cell.octant_splats() {
+                w.u64(n);
+            }
         });
         w.finish(Kind::Field)
     }
@@ -42,10 +46,15 @@ impl<H: LightHierarchy> GuidingField<H> {
         let guide = CutRules::new(lights, config).map_err(|e| config_error(e, at))?;
         let light_filter = untag(&mut r, "light filter", &FILTERS)?;
         let cells = BinaryTree::read(&mut r, |r| {
-            Ok(FieldCell {
-                sd: SdCell::read(r, &sd.config)?,
-                cut: GuidingCut::read(r, &guide)?,
-            })
+            let sd_cell = SdCell::read(r, &sd.config)?;
+            let cut = GuidingCut::read(r, &guide)?;
+            let mut octants = [0u64; 8];
+            if r.version() >= 3 {
+                for n in &mut octants {
+                    *n = r.u64("cell: octant light splats")?;
+                }
+            }
+            Ok(FieldCell::with_counts(sd_cell, cut, octants))
         })?;
         r.end()?;
         Ok(Self {
@@ -63,6 +72,7 @@ impl<H: LightHierarchy> GuidingField<H> {
         for cell in self.cells.data_slice_mut() {
             cell.sd.clear_records();
             cell.cut.clear_records();
+            cell.reset_counts();
         }
         self.sd.dropped.reset();
     }
@@ -95,6 +105,9 @@ impl<H: LightHierarchy> GuidingField<H> {
         {
             a.sd.merge(&b.sd);
             a.cut.merge(&b.cut);
+            for (x, y) in a.octants.iter_mut().zip(&b.octants) {
+                x.merge(y);
+            }
         }
         true
     }

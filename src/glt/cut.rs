@@ -57,6 +57,12 @@ pub struct GuidingCut {
     pub(super) seen: SumBuffer,
     /// Visibility records since the last rebuild.
     pub(super) seen_records: Counter,
+    /// How much of what the sampled copy learned came from shading points
+    /// inside the cut's own cell, in `[0, 1]`: 1 for a cut rebuilt from
+    /// its cell's own records, less for a half of a cell that split, by
+    /// its share of the records its parent learned from (see
+    /// [`GuidingCut::confidence`]).
+    pub(crate) confidence: f32,
 }
 
 /// Why [`GuidingCut::check`] rejected a cut.
@@ -165,6 +171,7 @@ impl GuidingCut {
             visibility: vec![1.0; visibility_slots(nodes_len, config)].into_boxed_slice(),
             seen: SumBuffer::new(2 * visibility_slots(nodes_len, config), config.accumulation),
             seen_records: Counter::new(),
+            confidence: 1.0,
         }
     }
 
@@ -172,6 +179,25 @@ impl GuidingCut {
     #[inline]
     pub fn nodes(&self) -> &[CutNode] {
         &self.nodes
+    }
+
+    /// How much of what the cut learned comes from its own cell, in
+    /// `[0, 1]`. Sampling trusts the learned distribution by this much
+    /// and the prior for the rest: the defensive weight becomes
+    /// `alpha + (1 - alpha) (1 - confidence)`, so a cut that learned
+    /// nothing of its own samples exactly as the prior does.
+    ///
+    /// A cut rebuilt from its cell's records has confidence 1. When a
+    /// cell splits, each half inherits the cut its parent learned from
+    /// records that fell mostly in one half or the other; a half whose
+    /// share `s` of those records is below an even split gets its parent's
+    /// confidence times `2 s` (a tile-order renderer that has rendered
+    /// only part of a cell leaves the other half at the prior, not at
+    /// another region's choice). The spatial structures set it
+    /// ([`Glt`](super::Glt)); a cut used on its own keeps 1.
+    #[inline]
+    pub fn confidence(&self) -> f32 {
+        self.confidence
     }
 
     /// The learned fraction of each unbounded light (before the mixture

@@ -38,6 +38,7 @@
 //! [`CutConfig::with_paper_rules`] gives the paper's one distribution per
 //! cell.
 
+mod cell;
 mod config;
 mod cut;
 mod cut_node;
@@ -55,5 +56,7 @@ pub use cut::{CutError, CutMemory, GuidingCut};
 pub use cut_node::{CutNode, Slot};
 pub use cut_rules::CutRules;
 pub use splat::SplatOutcome;
-pub use standalone::{Glt, GltCell, GltConfig, GltMemory, GltVertex};
+pub use cell::GltCell;
+pub(crate) use cell::{octant_of, split_octants};
+pub use standalone::{Glt, GltConfig, GltMemory, GltVertex};
 pub(crate) use visibility::valid_record;

@@ -6,7 +6,8 @@ use super::config::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
 use super::cut::{GuidingCut, MIN_VISIBILITY, anchor_sums, sum_count, visibility_slots};
 use super::cut_node::CutNode;
 use super::cut_rules::CutRules;
-use super::standalone::{Glt, GltCell, GltConfig};
+use super::cell::GltCell;
+use super::standalone::{Glt, GltConfig};
 use crate::dropped::DropCounters;
 use crate::light_sampler::UnboundedLights;
 use crate::light_tree::LightHierarchy;
@@ -119,6 +120,8 @@ impl GuidingCut {
         w.u64(self.recorded.get());
         self.anchor.write(w);
         w.bool(self.modulated);
+        // Version 3: how much of what it learned came from its own cell.
+        w.f32(self.confidence);
         // Version 2: the learned visibility, when the configuration learns
         // it (its length is the sums').
         if !self.visibility.is_empty() {
@@ -162,6 +165,11 @@ impl GuidingCut {
         let recorded = Counter::with(r.u64("cut: recorded")?);
         let anchor = SumBuffer::read(r, "cut: anchor", config.accumulation, anchor_sums(config))?;
         let modulated = r.bool("cut: modulated")?;
+        let confidence = if r.version() >= 3 {
+            r.check("cut: confidence", Reader::f32, |c| (0.0..=1.0).contains(c))?
+        } else {
+            1.0
+        };
         let slots = visibility_slots(count, config);
         let mut visibility = Vec::with_capacity(slots.min(r.left() / 4));
         for _ in 0..slots {
@@ -185,6 +193,7 @@ impl GuidingCut {
             visibility: visibility.into_boxed_slice(),
             seen,
             seen_records,
+            confidence,
         };
         cut.check(rules.light_tree())
             .map_err(|_| Reader::invalid("cut: nodes", at))?;
@@ -198,6 +207,7 @@ impl GuidingCut {
             && self.unbounded == other.unbounded
             && self.modulated == other.modulated
             && self.visibility == other.visibility
+            && self.confidence.to_bits() == other.confidence.to_bits()
     }
 
     /// Zeroes what was recorded since the last refinement (sums, anchor,
@@ -241,8 +251,13 @@ impl<H: LightHierarchy> Glt<H> {
         self.dropped.write(&mut w);
         self.spatial.write(&mut w, |cell, w| {
             cell.cut.write(w);
-            w.u64(cell.splats.get());
-            w.u64(cell.split_count);
+            // Version 3: the splats per octant, the splats the last
+            // refinement used and the cell's refinement count.
+            for n in cell.octant_splats() {
+                w.u64(n);
+            }
+            w.u64(cell.used);
+            w.u32(cell.generation);
         });
         w.finish(Kind::Glt)
     }
@@ -260,11 +275,24 @@ impl<H: LightHierarchy> Glt<H> {
         let iteration = r.u32("iteration")?;
         let dropped = DropCounters::read(&mut r)?;
         let spatial = crate::spatial::BinaryTree::read(&mut r, |r| {
-            Ok(GltCell {
-                cut: GuidingCut::read(r, &guide)?,
-                splats: Counter::with(r.u64("cell: splats")?),
-                split_count: r.u64("cell: split count")?,
-            })
+            let cut = GuidingCut::read(r, &guide)?;
+            if r.version() < 3 {
+                // Versions 1 and 2 counted a cell's splats as one number
+                // (and a split count that only lives inside a refinement):
+                // spread evenly over the octants; every cell had taken
+                // part in every refinement.
+                let splats = r.u64("cell: splats")?;
+                r.u64("cell: split count")?;
+                let octants = core::array::from_fn(|o| splats / 8 + u64::from((o as u64) < splats % 8));
+                return Ok(GltCell::with_counts(cut, octants, 0, iteration));
+            }
+            let mut octants = [0u64; 8];
+            for n in &mut octants {
+                *n = r.u64("cell: octant splats")?;
+            }
+            let used = r.u64("cell: splats used")?;
+            let generation = r.u32("cell: generation")?;
+            Ok(GltCell::with_counts(cut, octants, used, generation))
         })?;
         r.end()?;
         Ok(Self {
@@ -282,8 +310,9 @@ impl<H: LightHierarchy> Glt<H> {
     pub fn clear_records(&mut self) {
         for cell in self.spatial.data_slice_mut() {
             cell.cut.clear_records();
-            cell.splats.reset();
-            cell.split_count = 0;
+            for c in &mut cell.octants {
+                c.reset();
+            }
         }
         self.dropped.reset();
     }
@@ -312,15 +341,18 @@ impl<H: LightHierarchy> Glt<H> {
                 .data_slice()
                 .iter()
                 .zip(other.spatial.data_slice())
-                .all(|(a, b)| a.cut.same_layout(&b.cut));
+                .all(|(a, b)| {
+                    a.used == b.used && a.generation == b.generation && a.cut.same_layout(&b.cut)
+                });
         if !same {
             return false;
         }
         let cells = self.spatial.data_slice_mut();
         for (a, b) in cells.iter_mut().zip(other.spatial.data_slice()) {
             a.cut.merge(&b.cut);
-            a.splats.merge(&b.splats);
-            a.split_count = a.split_count.saturating_add(b.split_count);
+            for (x, y) in a.octants.iter_mut().zip(&b.octants) {
+                x.merge(y);
+            }
         }
         self.dropped.merge(&other.dropped);
         true

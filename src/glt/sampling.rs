@@ -7,6 +7,9 @@
 //! pmf(u_i) = (1 - alpha) f_i + alpha q / k
 //! ```
 //!
+//! with `alpha` the defensive weight raised by the cut's doubt,
+//! `alpha + (1 - alpha) (1 - confidence)` ([`GuidingCut::confidence`]: 1
+//! for a cut learned from its own cell, so usually `alpha` itself),
 //! where `f_i` is the cell's learned fraction of unbounded light `u_i` (of
 //! `k`, `F` their sum), `q` the user's prior probability of the unbounded
 //! lights together (both 0 without any), `P_prior` the
@@ -66,7 +69,10 @@ impl Mixture {
     /// lights, if any, share everything in proportion to their weights).
     #[inline]
     pub(crate) fn new(emitters: bool, cut: &GuidingCut, config: &CutConfig) -> Self {
-        let a = config.alpha;
+        // Trust what the cut learned only as far as it learned it in its
+        // own cell (exactly `alpha` at confidence 1).
+        let doubt = 1.0 - f64::from(cut.confidence.clamp(0.0, 1.0));
+        let a = config.alpha + (1.0 - config.alpha) * doubt;
         let k = cut.unbounded.len();
         if k == 0 {
             return Self {

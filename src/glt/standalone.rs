@@ -14,11 +14,12 @@ use crate::error::{ConfigError, Error};
 use crate::light_sampler::{LightId, LightSample, LightSampler};
 use crate::light_tree::LightHierarchy;
 use crate::math::pmf_to_f32;
-use crate::math::{Aabb, Counter};
+use crate::math::Aabb;
 use crate::spatial::{
-    BinaryTree, CellId, RefineOutcome, SpatialFilter, SpatialTree, jitter_offset, split_threshold,
+    BinaryTree, CellId, RefineOutcome, SpatialFilter, SpatialTree, jitter_offset,
 };
-use crate::spatial::{Jitter, content_scale};
+use crate::spatial::{Growth, Jitter, content_scale};
+use super::cell::GltCell;
 use glam::Vec3;
 
 /// Parameters of a [`Glt`]: the cuts' and the spatial tree's.
@@ -26,10 +27,11 @@ use glam::Vec3;
 pub struct GltConfig {
     /// How each cell's cut is refined and sampled.
     pub cut: CutConfig,
-    /// PPG's spatial threshold `c`: after iteration `k` (counted from 0) a
-    /// cell splits while its number of splats exceeds `c * sqrt(2^k)`; each
-    /// split halves the count and gives both halves a copy of the cut and
-    /// its statistics. Default 12000 (PPG's).
+    /// PPG's spatial threshold `c`: a cell that takes part in its `g`-th
+    /// refinement (counted from 0, see [`Glt::refine`]) splits while its
+    /// number of splats exceeds `c * sqrt(2^g)`; each split halves the
+    /// count and gives both halves a copy of the cut and its statistics.
+    /// Default 12000 (PPG's).
     pub spatial_threshold: f64,
     /// Cap, in bytes, on the spatial tree plus the cells' cuts (their
     /// nodes and sums) after every [`Glt::refine`]; `None` for none. Cell
@@ -68,38 +70,6 @@ impl Default for GltConfig {
             max_bytes: None,
             filter: SpatialFilter::Nearest,
         }
-    }
-}
-
-/// What a cell of a [`Glt`] holds: its cut and the number of splats it
-/// received this iteration (for spatial refinement).
-#[derive(Clone, Debug)]
-pub struct GltCell {
-    pub(super) cut: GuidingCut,
-    pub(super) splats: Counter,
-    /// The count the spatial split rule sees during `refine` (halved at
-    /// each split).
-    pub(super) split_count: u64,
-}
-
-impl AsRef<GuidingCut> for GltCell {
-    #[inline]
-    fn as_ref(&self) -> &GuidingCut {
-        &self.cut
-    }
-}
-
-impl GltCell {
-    /// The cell's cut.
-    #[inline]
-    pub fn cut(&self) -> &GuidingCut {
-        &self.cut
-    }
-
-    /// Splats (zero values included) received since the last refinement.
-    #[inline]
-    pub fn splats(&self) -> u64 {
-        self.splats.get()
     }
 }
 
@@ -164,11 +134,7 @@ impl<H: LightHierarchy> Glt<H> {
     pub fn new(tree: H, scene: Aabb, config: GltConfig) -> Result<Self, Error> {
         config.validate()?;
         let guide = CutRules::new(tree, config.cut)?;
-        let cell = GltCell {
-            cut: guide.new_cut(),
-            splats: Counter::new(),
-            split_count: 0,
-        };
+        let cell = GltCell::new(guide.new_cut());
         Ok(Self {
             guide,
             config,
@@ -261,15 +227,14 @@ impl<H: LightHierarchy> Glt<H> {
         filter: SpatialFilter,
         jitter: impl FnOnce() -> Vec3,
     ) -> SplatOutcome {
+        let octant = at.map_or(0, |(_, bounds)| GltCell::octant(p, &bounds));
         let outcome = self.guide.splat_spread(
             &self.spatial,
             (p, at),
             light,
             value,
             (filter, jitter),
-            |cell| {
-                cell.splats.bump();
-            },
+            |cell| cell.count(octant),
         );
         if outcome == SplatOutcome::Dropped {
             self.reject();
@@ -320,20 +285,33 @@ impl<H: LightHierarchy> Glt<H> {
         self.dropped.count(DropReason::Light);
     }
 
-    /// Ends an iteration: splits cells that received more than
-    /// `c * sqrt(2^k)` splats (both halves get a copy of the cut and its
-    /// sums), refines every cut from its sums (a cell that collected nothing
-    /// keeps its cut) and zeroes the sums and counts. Returns what the
-    /// spatial refinement did, as [`SdTree::refine`](crate::sd_tree::SdTree::refine)
-    /// and [`GuidingField::refine`](crate::field::GuidingField::refine) do.
+    /// Turns what was recorded into the cuts sampled next, cell by cell
+    /// (`&mut self`: between passes or tiles, or through
+    /// [`SharedGuide`](crate::shared_guide::SharedGuide)).
+    ///
+    /// A cell takes part once it holds 3/2 of the splats its last
+    /// refinement used (any, before its first; see [`GltCell`]); the others
+    /// keep accumulating. A cell that takes part splits while its count is
+    /// above `c sqrt(2^g)` (`c` the spatial threshold, `g` the refinements
+    /// it took part in, a half taken to have half its parent's splats: PPG's
+    /// rule, with the cell's own clock); both halves get a copy of the cut
+    /// and its sums, and each the confidence of its share of the records
+    /// ([`GuidingCut::confidence`]). Then its cut is rebuilt from its sums
+    /// ([`CutRules::refine`]; a cut that collected nothing keeps its
+    /// distribution) within the memory budget. A renderer that refines
+    /// after every iteration of PPG's doubling schedule makes every cell
+    /// take part every time; one that renders tile by tile may refine
+    /// after every few tiles. Returns what the spatial refinement did, as
+    /// [`SdTree::refine`](crate::sd_tree::SdTree::refine) and
+    /// [`GuidingField::refine`](crate::field::GuidingField::refine) do.
     pub fn refine(&mut self) -> RefineOutcome {
         for cell in self.spatial.data_slice_mut() {
-            cell.split_count = cell.splats.get();
+            cell.begin();
         }
-        let outcome = self.spatial.split_by_weight(
-            split_threshold(self.config.spatial_threshold, self.iteration),
-            |cell| cell.split_count as f64,
-            |cell| cell.split_count /= 2,
+        let c = self.config.spatial_threshold;
+        let outcome = self.spatial.refine_along(
+            |cell, _| cell.splits(c),
+            |cell, axis| cell.split(axis),
             |cell| cell.cut.heap_bytes(),
             self.config.max_bytes,
         );
@@ -343,13 +321,23 @@ impl<H: LightHierarchy> Glt<H> {
         let scale = content_scale(
             self.config.max_bytes,
             self.spatial.bytes(),
-            cells.iter().map(|c| guide.growth(&c.cut)),
+            // A cell that does not take part keeps its cut as it is.
+            cells.iter().map(|c| match c.pass.ready {
+                true => guide.growth(&c.cut),
+                false => Growth {
+                    fixed: c.cut.heap_bytes(),
+                    nodes: 0,
+                    per_node: 0,
+                },
+            }),
         );
         for cell in self.spatial.data_slice_mut() {
+            if !cell.pass.ready {
+                continue;
+            }
             let cap = scale.and_then(|_| guide.growth(&cell.cut).cap(scale));
-            guide.refine_within(&mut cell.cut, cap);
-            cell.splats.reset();
-            cell.split_count = 0;
+            let rebuilt = guide.refine_within(&mut cell.cut, cap);
+            cell.end(rebuilt);
         }
         self.iteration = self.iteration.saturating_add(1);
         outcome

@@ -85,11 +85,17 @@ impl<H: LightHierarchy> CutRules<H> {
     }
 
     /// The learned visibility of the slot (or unbounded light) of sum
-    /// `sum` in `cut` (1 for none).
+    /// `sum` in `cut` (1 for none), trusted as far as the cut's
+    /// [`GuidingCut::confidence`]: `1 - confidence (1 - v)`, so a cut that
+    /// learned nothing of its own assumes nothing is hidden.
     #[inline]
     pub(super) fn visibility_at(&self, cut: &GuidingCut, sum: Option<usize>) -> f32 {
-        sum.and_then(|i| cut.visibility.get(i).copied())
-            .unwrap_or(1.0)
+        let v = sum.and_then(|i| cut.visibility.get(i).copied()).unwrap_or(1.0);
+        if cut.confidence >= 1.0 {
+            v
+        } else {
+            1.0 - cut.confidence * (1.0 - v)
+        }
     }
 
     /// The visibilities of a rebuilt cut whose nodes were `old` (the cut

@@ -42,6 +42,17 @@
 //! iteration are not needed (nothing refines after it): stop recording
 //! there to save their cost.
 //!
+//! A renderer that renders each tile to completion (pbrt-v3, rs_pbrt:
+//! all of a tile's samples, tile after tile) has no rounds: it records as
+//! it goes and calls `refine()` after every few tiles (a wave of as many
+//! tiles as it has threads, say). The GLT refines cell by cell
+//! (`glt::GltCell`): a cell takes part once it holds 3/2 of the records
+//! its last refinement used, so the cells the tiles have reached learn
+//! while the others wait for records of their own, and a half of a cell
+//! that the records never reached falls back to the prior
+//! (`glt::GuidingCut::confidence`) instead of sampling with a choice
+//! learned elsewhere.
+//!
 //! Zero-valued records (an occluded shadow ray, a path that found no light)
 //! are valid observations everywhere in the crate: they add nothing to the
 //! sums but count as samples for the spatial split rules, so record them as

@@ -11,12 +11,15 @@ impl SdState {
     /// rule on the collected weights within `max_bytes`, counting
     /// `heap_bytes` per cell. Within `max_bytes` the quadtrees and the
     /// other content grow by one shared factor (`src/spatial/budget.rs`),
-    /// passed to `per_cell`. Returns what the spatial pass did.
+    /// passed to `per_cell`; `on_split(lower, upper, axis)` adjusts the
+    /// two halves of a cell split along `axis` (the upper a copy of the
+    /// lower). Returns what the spatial pass did.
     pub(crate) fn refine<C: AsRef<SdCell> + AsMut<SdCell> + Clone>(
         &mut self,
         tree: &mut BinaryTree<C>,
         other: impl Fn(&C) -> Growth,
         mut per_cell: impl FnMut(&mut C, Option<f64>),
+        mut on_split: impl FnMut(&mut C, &mut C, usize),
         heap_bytes: impl FnMut(&C) -> usize,
     ) -> RefineOutcome {
         let config = self.config;
@@ -32,10 +35,15 @@ impl SdState {
             cell.as_mut().end_iteration(&config, cap);
             per_cell(cell, scale);
         }
-        let outcome = tree.split_by_weight(
-            config.split_threshold(self.iteration),
-            |cell| cell.as_ref().split_weight,
-            |cell| cell.as_mut().split_weight *= 0.5,
+        let threshold = config.split_threshold(self.iteration);
+        let outcome = tree.refine_along(
+            |cell, _| cell.as_ref().split_weight > threshold,
+            |cell, axis| {
+                cell.as_mut().split_weight *= 0.5;
+                let mut upper = cell.clone();
+                on_split(cell, &mut upper, axis);
+                upper
+            },
             heap_bytes,
             config.max_bytes,
         );
@@ -59,6 +67,7 @@ impl SdTree {
             &mut self.tree,
             |_| Growth::default(),
             |_, _| {},
+            |_, _, _| {},
             |cell| cell.heap_bytes(),
         )
     }

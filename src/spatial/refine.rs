@@ -56,8 +56,20 @@ impl<T> BinaryTree<T> {
     /// original); after the split the upper child's real size is charged.
     pub fn refine_with_heap(
         &mut self,
-        mut should_split: impl FnMut(&T, u32) -> bool,
+        should_split: impl FnMut(&T, u32) -> bool,
         mut split: impl FnMut(&mut T) -> T,
+        heap_bytes: impl FnMut(&T) -> usize,
+        max_bytes: Option<usize>,
+    ) -> RefineOutcome {
+        self.refine_along(should_split, |t, _| split(t), heap_bytes, max_bytes)
+    }
+
+    /// [`BinaryTree::refine_with_heap`] telling `split` the axis the cell
+    /// is halved along (0, 1, 2: x, y, z).
+    pub(crate) fn refine_along(
+        &mut self,
+        mut should_split: impl FnMut(&T, u32) -> bool,
+        mut split: impl FnMut(&mut T, usize) -> T,
         mut heap_bytes: impl FnMut(&T) -> usize,
         max_bytes: Option<usize>,
     ) -> RefineOutcome {
@@ -88,7 +100,7 @@ impl<T> BinaryTree<T> {
                     continue;
                 }
             }
-            let upper_data = split(&mut self.cells[ci]);
+            let upper_data = split(&mut self.cells[ci], axis);
             if max_bytes.is_some() {
                 used += fixed + heap_bytes(&upper_data);
             }

@@ -1,0 +1,311 @@
+//! [`GltCell`]: what a cell of a [`Glt`](super::Glt) holds, when it
+//! refines, and what each half of it inherits when it splits.
+//!
+//! A cell refines on what it has seen itself, not on a global clock: it
+//! takes part in a refinement once it holds 3/2 of the splats its last
+//! refinement used (any splat before its first), and its spatial split
+//! threshold is `c sqrt(2^g)` with `g` its own refinement count. A
+//! renderer that refines after every pass of PPG's doubling schedule
+//! makes every cell take part every time (each pass doubles the splats),
+//! which is PPG's rule; one that refines after every few tiles makes the
+//! cells the tiles reached refine and leaves the others accumulating.
+//!
+//! The splats are counted per octant of the cell, so when a cell splits
+//! each half knows its share of the records its parent learned from (for
+//! three levels: a split halves one axis and keeps the other two). A half
+//! with less than an even share trusts the inherited cut less
+//! ([`GuidingCut::confidence`]), down to the prior for a half the records
+//! never reached.
+
+use super::cut::GuidingCut;
+use crate::math::{Aabb, Counter};
+use crate::spatial::split_threshold;
+use glam::Vec3;
+
+/// A cell takes part in a refinement once it has collected
+/// `READY_NUM / READY_DEN` times the splats its last refinement used.
+const READY_NUM: u64 = 3;
+const READY_DEN: u64 = 2;
+
+/// The octant of a cell with `bounds` that `p` falls in: bit 0 set for
+/// `x` at or above the centre, bit 1 for `y`, bit 2 for `z` (a point
+/// outside counts in the nearest).
+#[inline]
+pub(crate) fn octant_of(p: Vec3, bounds: &Aabb) -> usize {
+    let c = bounds.center();
+    usize::from(p.x >= c.x) | usize::from(p.y >= c.y) << 1 | usize::from(p.z >= c.z) << 2
+}
+
+/// Splits per-octant counts `counts` of a cell halved along `axis` (0,
+/// 1, 2): each half's octant counts (along `axis` its own octants are not
+/// known: the count is shared evenly) and its confidence factor, `min(1,
+/// 2 share)` of the records (1 when there are none). Lower half first.
+pub(crate) fn split_octants(counts: [u64; 8], axis: usize) -> [([u64; 8], f32); 2] {
+    let bit = 1usize << axis;
+    let total: u64 = counts.iter().sum();
+    let mut halves = [[0u64; 8]; 2];
+    for (o, &n) in counts.iter().enumerate() {
+        let half = &mut halves[usize::from(o & bit != 0)];
+        half[o & !bit] += n / 2;
+        half[o | bit] += n - n / 2;
+    }
+    halves.map(|half| {
+        let factor = if total == 0 {
+            1.0
+        } else {
+            let share = half.iter().sum::<u64>() as f64 / total as f64;
+            (2.0 * share).min(1.0) as f32
+        };
+        (half, factor)
+    })
+}
+
+/// One cell of a [`Glt`](super::Glt): its cut and what decides its
+/// refinement.
+#[derive(Clone, Debug)]
+pub struct GltCell {
+    pub(super) cut: GuidingCut,
+    /// Splats (zero values included) since the cell last took part in a
+    /// refinement, per octant of the cell: bit 0 set for `x` at or above
+    /// the cell's centre, bit 1 for `y`, bit 2 for `z`.
+    pub(super) octants: [Counter; 8],
+    /// The splats its last refinement used (0 before the first).
+    pub(super) used: u64,
+    /// Refinements it took part in (a half starts from its parent's).
+    pub(super) generation: u32,
+    /// State of the refinement in progress (inside `Glt::refine` only).
+    pub(super) pass: Pass,
+}
+
+/// A cell's part in the refinement in progress.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Pass {
+    /// Whether the cell takes part.
+    pub(super) ready: bool,
+    /// The splats the split rule sees: the cell's, halved at each split
+    /// (PPG's rule).
+    pub(super) count: u64,
+    /// The confidence its cut keeps from this pass's splits: the product
+    /// of `min(1, 2 share)` over them.
+    pub(super) factor: f32,
+}
+
+impl Default for Pass {
+    fn default() -> Self {
+        Self {
+            ready: false,
+            count: 0,
+            factor: 1.0,
+        }
+    }
+}
+
+impl AsRef<GuidingCut> for GltCell {
+    #[inline]
+    fn as_ref(&self) -> &GuidingCut {
+        &self.cut
+    }
+}
+
+impl GltCell {
+    /// A cell with `cut`, nothing recorded.
+    pub(super) fn new(cut: GuidingCut) -> Self {
+        Self::with_counts(cut, [0; 8], 0, 0)
+    }
+
+    /// A cell with `cut` and the given counts (a loaded one).
+    pub(super) fn with_counts(cut: GuidingCut, octants: [u64; 8], used: u64, generation: u32) -> Self {
+        Self {
+            cut,
+            octants: octants.map(Counter::with),
+            used,
+            generation,
+            pass: Pass::default(),
+        }
+    }
+
+    /// The cell's cut.
+    #[inline]
+    pub fn cut(&self) -> &GuidingCut {
+        &self.cut
+    }
+
+    /// Splats (zero values included) received since the cell last took
+    /// part in a refinement.
+    #[inline]
+    pub fn splats(&self) -> u64 {
+        self.octant_splats().iter().sum()
+    }
+
+    /// [`GltCell::splats`] per octant of the cell (bit 0 of the index set
+    /// for `x` at or above the cell's centre, bit 1 for `y`, bit 2 for
+    /// `z`).
+    pub fn octant_splats(&self) -> [u64; 8] {
+        core::array::from_fn(|o| self.octants[o].get())
+    }
+
+    /// Refinements the cell took part in (a half counts its parent's).
+    #[inline]
+    pub fn generation(&self) -> u32 {
+        self.generation
+    }
+
+    /// [`octant_of`].
+    #[inline]
+    pub(super) fn octant(p: Vec3, bounds: &Aabb) -> usize {
+        octant_of(p, bounds)
+    }
+
+    /// Counts a splat from `octant`.
+    #[inline]
+    pub(super) fn count(&self, octant: usize) {
+        self.octants[octant & 7].bump();
+    }
+
+    /// Starts a refinement: the cell takes part if it has 3/2 of the
+    /// splats its last refinement used (any, before its first).
+    pub(super) fn begin(&mut self) {
+        let n = self.splats();
+        self.pass = Pass {
+            ready: n > 0 && n.saturating_mul(READY_DEN) >= self.used.saturating_mul(READY_NUM),
+            count: n,
+            factor: 1.0,
+        };
+    }
+
+    /// Whether the spatial split rule splits the cell, with threshold
+    /// constant `c`: it takes part and its count is above `c sqrt(2^g)`.
+    pub(super) fn splits(&self, c: f64) -> bool {
+        self.pass.ready && self.pass.count as f64 > split_threshold(c, self.generation)
+    }
+
+    /// Splits the cell along `axis` (0, 1, 2): it becomes the lower half
+    /// and the upper half is returned. Both keep the cut and its sums;
+    /// each gets the octant counts that fell in it (along `axis` its own
+    /// octants are not known: the count is shared evenly), its share of
+    /// the records as a confidence factor, and half the split count.
+    pub(super) fn split(&mut self, axis: usize) -> Self {
+        let [(lower, lower_factor), (upper_counts, upper_factor)] =
+            split_octants(self.octant_splats(), axis);
+        self.pass.count /= 2;
+        let mut upper = self.clone();
+        self.octants = lower.map(Counter::with);
+        self.pass.factor *= lower_factor;
+        upper.octants = upper_counts.map(Counter::with);
+        upper.pass.factor *= upper_factor;
+        upper
+    }
+
+    /// Ends a refinement for a cell that took part, after `rebuild`
+    /// rebuilt its cut (`true`) or kept it: the cut's confidence becomes
+    /// this pass's factor (rebuilt from the records the cell inherited)
+    /// or is multiplied by it (kept), the cell remembers how many splats
+    /// it used and starts counting again.
+    pub(super) fn end(&mut self, rebuilt: bool) {
+        let factor = self.pass.factor;
+        self.cut.confidence = if rebuilt {
+            factor
+        } else {
+            self.cut.confidence * factor
+        };
+        self.used = self.pass.count;
+        self.generation = self.generation.saturating_add(1);
+        for c in &mut self.octants {
+            c.reset();
+        }
+        self.pass = Pass::default();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emitter::Emitter;
+    use crate::glt::{CutConfig, CutRules};
+    use crate::light_tree::{BuildHeuristic, LightTree};
+
+    fn cell_with(octants: [u64; 8], used: u64) -> GltCell {
+        let lights = [Emitter::point(Vec3::ZERO, 1.0), Emitter::point(Vec3::X, 1.0)];
+        let tree = LightTree::build(&lights[..], BuildHeuristic::Sarh).unwrap();
+        let rules = CutRules::new(&tree, CutConfig::default()).unwrap();
+        GltCell::with_counts(rules.new_cut(), octants, used, 0)
+    }
+
+    #[test]
+    fn a_point_counts_in_its_octant() {
+        let b = Aabb::new(Vec3::ZERO, Vec3::splat(2.0));
+        assert_eq!(GltCell::octant(Vec3::splat(0.5), &b), 0);
+        assert_eq!(GltCell::octant(Vec3::new(1.5, 0.5, 0.5), &b), 1);
+        assert_eq!(GltCell::octant(Vec3::new(0.5, 1.5, 0.5), &b), 2);
+        assert_eq!(GltCell::octant(Vec3::new(0.5, 0.5, 1.5), &b), 4);
+        assert_eq!(GltCell::octant(Vec3::splat(1.0), &b), 7, "the centre counts above");
+        assert_eq!(GltCell::octant(Vec3::splat(-5.0), &b), 0, "outside: the nearest");
+    }
+
+    /// A cell takes part once it has 3/2 of what its last refinement
+    /// used; before its first, once it has anything.
+    #[test]
+    fn a_cell_takes_part_at_three_halves_of_its_last_count() {
+        let ready = |n: u64, used: u64| {
+            let mut c = cell_with([n, 0, 0, 0, 0, 0, 0, 0], used);
+            c.begin();
+            c.pass.ready
+        };
+        assert!(!ready(0, 0));
+        assert!(ready(1, 0));
+        assert!(!ready(149, 100));
+        assert!(ready(150, 100));
+        assert!(ready(u64::MAX, u64::MAX / 2));
+    }
+
+    /// Records all in one octant: the half that holds it keeps the full
+    /// confidence, the other gets none; three levels deep the counts are
+    /// exact. Records spread evenly: every half keeps the full confidence.
+    #[test]
+    fn each_half_gets_its_share_of_the_records() {
+        let mut lower = cell_with([800, 0, 0, 0, 0, 0, 0, 0], 0);
+        lower.begin();
+        let upper = lower.split(0);
+        assert_eq!((lower.splats(), upper.splats()), (800, 0));
+        assert_eq!((lower.pass.factor, upper.pass.factor), (1.0, 0.0));
+        assert_eq!((lower.pass.count, upper.pass.count), (400, 400), "PPG's halving");
+        let lower_y = lower.split(1);
+        assert_eq!((lower.splats(), lower_y.splats()), (800, 0));
+        let upper_z = lower.split(2);
+        assert_eq!((lower.splats(), upper_z.splats()), (800, 0));
+        assert_eq!(upper_z.pass.factor, 0.0);
+        // Along x again: unknown, shared evenly.
+        let upper_x = lower.split(0);
+        assert_eq!((lower.splats(), upper_x.splats()), (400, 400));
+        assert_eq!((lower.pass.factor, upper_x.pass.factor), (1.0, 1.0));
+
+        let mut even = cell_with([100; 8], 0);
+        even.begin();
+        let other = even.split(1);
+        assert_eq!((even.splats(), other.splats()), (400, 400));
+        assert_eq!((even.pass.factor, other.pass.factor), (1.0, 1.0));
+        // A quarter of the records: half the confidence.
+        let mut skewed = cell_with([300, 100, 300, 100, 300, 100, 300, 100], 0);
+        skewed.begin();
+        let right = skewed.split(0);
+        assert_eq!((skewed.pass.factor, right.pass.factor), (1.0, 0.5));
+    }
+
+    /// A refinement the cell took part in: confidence from this pass's
+    /// splits when the cut was rebuilt, multiplied into the old one when it
+    /// was kept; the count restarts and the generation moves on.
+    #[test]
+    fn ending_a_pass_sets_the_confidence_and_restarts_the_count() {
+        let mut c = cell_with([200, 600, 0, 0, 0, 0, 0, 0], 0);
+        c.begin();
+        let mut upper = c.split(0);
+        upper.end(true);
+        assert_eq!(upper.cut.confidence(), 1.0);
+        c.end(false);
+        assert_eq!(c.cut.confidence(), 0.5);
+        assert_eq!((c.splats(), c.used, c.generation), (0, 400, 1));
+        c.count(3);
+        c.begin();
+        assert!(!c.pass.ready, "1 of the 600 it needs");
+    }
+}
