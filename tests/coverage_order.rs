@@ -9,6 +9,7 @@ use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
 use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
+use guiding::spatial::SpatialTree;
 use guiding::{Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext};
 
 /// The variance of the one-sample estimate `f(e) / pmf(e)` of the direct
@@ -31,12 +32,21 @@ fn variance<S: LightSampler>(sampler: &S, lights: &[Emitter], p: Vec3) -> f64 {
 /// Trains `glt` from shading points in the half `x < 0` only (the left
 /// room: the part of the image rendered so far), sampling from the GLT
 /// as a renderer would, then refines.
-fn train_left_half<H: LightHierarchy>(glt: &mut Glt<H>, lights: &[Emitter], rng: &mut Rand, n: usize) {
+fn train_left_half<H: LightHierarchy>(
+    glt: &mut Glt<H>,
+    lights: &[Emitter],
+    rng: &mut Rand,
+    n: usize,
+) {
     for _ in 0..n {
         let q = rng.point(9.5);
         let p = Vec3::new(-q.x.abs().max(0.01), q.y, q.z);
-        let Some(s) = glt.sample(&ShadingContext::at(p), rng.f()) else { continue };
-        let LightId::Emitter(e) = s.light else { continue };
+        let Some(s) = glt.sample(&ShadingContext::at(p), rng.f()) else {
+            continue;
+        };
+        let LightId::Emitter(e) = s.light else {
+            continue;
+        };
         glt.splat_at(p, s.light, value(lights, e, p) / s.pmf);
     }
     glt.refine();
@@ -61,7 +71,10 @@ fn the_half_not_rendered_yet_keeps_the_prior_choice() {
         let q = rng.point(9.0);
         let left = Vec3::new(-q.x.abs().max(0.5), q.y, q.z);
         let right = Vec3::new(q.x.abs().max(0.5), q.y, q.z);
-        let (learned, untrained) = (variance(&glt, &lights, right), variance(&prior, &lights, right));
+        let (learned, untrained) = (
+            variance(&glt, &lights, right),
+            variance(&prior, &lights, right),
+        );
         assert!(
             learned <= untrained * (1.0 + 1e-6),
             "at {right} (not rendered yet): variance {learned} against the prior's {untrained} (point {k})"
@@ -69,5 +82,8 @@ fn the_half_not_rendered_yet_keeps_the_prior_choice() {
         better += usize::from(variance(&glt, &lights, left) < variance(&prior, &lights, left));
         n += 1;
     }
-    assert!(better * 4 > n * 3, "learned better at {better} of {n} left-room points");
+    assert!(
+        better * 4 > n * 3,
+        "learned better at {better} of {n} left-room points"
+    );
 }

@@ -2,8 +2,9 @@
 //! refines, and what each half of it inherits when it splits.
 //!
 //! A cell refines on what it has seen itself, not on a global clock: it
-//! takes part in a refinement once it holds 3/2 of the splats its last
-//! refinement used (any splat before its first), and its spatial split
+//! takes part in a refinement once it holds 3/2 of the splats that fell
+//! in it before its last one (for a half born of a split, its own share of
+//! its parent's; any splat before its first), and its spatial split
 //! threshold is `c sqrt(2^g)` with `g` its own refinement count. A
 //! renderer that refines after every pass of PPG's doubling schedule
 //! makes every cell take part every time (each pass doubles the splats),
@@ -13,9 +14,9 @@
 //! The splats are counted per octant of the cell, so when a cell splits
 //! each half knows its share of the records its parent learned from (for
 //! three levels: a split halves one axis and keeps the other two). A half
-//! with less than an even share trusts the inherited cut less
+//! with less than a quarter of them trusts the inherited cut less
 //! ([`GuidingCut::confidence`]), down to the prior for a half the records
-//! never reached.
+//! never reached, until it refines on records of its own.
 
 use super::cut::GuidingCut;
 use crate::math::{Aabb, Counter};
@@ -23,7 +24,7 @@ use crate::spatial::split_threshold;
 use glam::Vec3;
 
 /// A cell takes part in a refinement once it has collected
-/// `READY_NUM / READY_DEN` times the splats its last refinement used.
+/// `READY_NUM / READY_DEN` times the splats that fell in it before its last.
 const READY_NUM: u64 = 3;
 const READY_DEN: u64 = 2;
 
@@ -36,10 +37,19 @@ pub(crate) fn octant_of(p: Vec3, bounds: &Aabb) -> usize {
     usize::from(p.x >= c.x) | usize::from(p.y >= c.y) << 1 | usize::from(p.z >= c.z) << 2
 }
 
+/// A half of a split cell that holds at least this share of the records
+/// its parent's cut learned from keeps the cut's confidence; below it the
+/// confidence falls in proportion, to 0 for a half no record came from.
+/// Not 1/2: a half of a cell evenly covered holds a little more or less
+/// than half by chance, and a cut learned from a quarter of its records
+/// or more is still the cell's own.
+pub(crate) const TRUSTED_SHARE: f64 = 0.25;
+
 /// Splits per-octant counts `counts` of a cell halved along `axis` (0,
 /// 1, 2): each half's octant counts (along `axis` its own octants are not
 /// known: the count is shared evenly) and its confidence factor, `min(1,
-/// 2 share)` of the records (1 when there are none). Lower half first.
+/// share / TRUSTED_SHARE)` of the records (1 when there are none). Lower
+/// half first.
 pub(crate) fn split_octants(counts: [u64; 8], axis: usize) -> [([u64; 8], f32); 2] {
     let bit = 1usize << axis;
     let total: u64 = counts.iter().sum();
@@ -54,7 +64,7 @@ pub(crate) fn split_octants(counts: [u64; 8], axis: usize) -> [([u64; 8], f32); 
             1.0
         } else {
             let share = half.iter().sum::<u64>() as f64 / total as f64;
-            (2.0 * share).min(1.0) as f32
+            (share / TRUSTED_SHARE).min(1.0) as f32
         };
         (half, factor)
     })
@@ -69,7 +79,8 @@ pub struct GltCell {
     /// refinement, per octant of the cell: bit 0 set for `x` at or above
     /// the cell's centre, bit 1 for `y`, bit 2 for `z`.
     pub(super) octants: [Counter; 8],
-    /// The splats its last refinement used (0 before the first).
+    /// The splats that fell in the cell before its last refinement (its
+    /// share of them, for a half born of a split; 0 before the first).
     pub(super) used: u64,
     /// Refinements it took part in (a half starts from its parent's).
     pub(super) generation: u32,
@@ -114,7 +125,12 @@ impl GltCell {
     }
 
     /// A cell with `cut` and the given counts (a loaded one).
-    pub(super) fn with_counts(cut: GuidingCut, octants: [u64; 8], used: u64, generation: u32) -> Self {
+    pub(super) fn with_counts(
+        cut: GuidingCut,
+        octants: [u64; 8],
+        used: u64,
+        generation: u32,
+    ) -> Self {
         Self {
             cut,
             octants: octants.map(Counter::with),
@@ -163,7 +179,7 @@ impl GltCell {
     }
 
     /// Starts a refinement: the cell takes part if it has 3/2 of the
-    /// splats its last refinement used (any, before its first).
+    /// splats that fell in it before its last one (any, before its first).
     pub(super) fn begin(&mut self) {
         let n = self.splats();
         self.pass = Pass {
@@ -208,7 +224,9 @@ impl GltCell {
         } else {
             self.cut.confidence * factor
         };
-        self.used = self.pass.count;
+        // Its own records, not the split rule's halved count: a half that
+        // got few of its parent's records refines again on few of its own.
+        self.used = self.splats();
         self.generation = self.generation.saturating_add(1);
         for c in &mut self.octants {
             c.reset();
@@ -225,7 +243,10 @@ mod tests {
     use crate::light_tree::{BuildHeuristic, LightTree};
 
     fn cell_with(octants: [u64; 8], used: u64) -> GltCell {
-        let lights = [Emitter::point(Vec3::ZERO, 1.0), Emitter::point(Vec3::X, 1.0)];
+        let lights = [
+            Emitter::point(Vec3::ZERO, 1.0),
+            Emitter::point(Vec3::X, 1.0),
+        ];
         let tree = LightTree::build(&lights[..], BuildHeuristic::Sarh).unwrap();
         let rules = CutRules::new(&tree, CutConfig::default()).unwrap();
         GltCell::with_counts(rules.new_cut(), octants, used, 0)
@@ -238,8 +259,16 @@ mod tests {
         assert_eq!(GltCell::octant(Vec3::new(1.5, 0.5, 0.5), &b), 1);
         assert_eq!(GltCell::octant(Vec3::new(0.5, 1.5, 0.5), &b), 2);
         assert_eq!(GltCell::octant(Vec3::new(0.5, 0.5, 1.5), &b), 4);
-        assert_eq!(GltCell::octant(Vec3::splat(1.0), &b), 7, "the centre counts above");
-        assert_eq!(GltCell::octant(Vec3::splat(-5.0), &b), 0, "outside: the nearest");
+        assert_eq!(
+            GltCell::octant(Vec3::splat(1.0), &b),
+            7,
+            "the centre counts above"
+        );
+        assert_eq!(
+            GltCell::octant(Vec3::splat(-5.0), &b),
+            0,
+            "outside: the nearest"
+        );
     }
 
     /// A cell takes part once it has 3/2 of what its last refinement
@@ -268,7 +297,11 @@ mod tests {
         let upper = lower.split(0);
         assert_eq!((lower.splats(), upper.splats()), (800, 0));
         assert_eq!((lower.pass.factor, upper.pass.factor), (1.0, 0.0));
-        assert_eq!((lower.pass.count, upper.pass.count), (400, 400), "PPG's halving");
+        assert_eq!(
+            (lower.pass.count, upper.pass.count),
+            (400, 400),
+            "PPG's halving"
+        );
         let lower_y = lower.split(1);
         assert_eq!((lower.splats(), lower_y.splats()), (800, 0));
         let upper_z = lower.split(2);
@@ -284,8 +317,13 @@ mod tests {
         let other = even.split(1);
         assert_eq!((even.splats(), other.splats()), (400, 400));
         assert_eq!((even.pass.factor, other.pass.factor), (1.0, 1.0));
-        // A quarter of the records: half the confidence.
+        // A quarter of the records: still the cell's own.
         let mut skewed = cell_with([300, 100, 300, 100, 300, 100, 300, 100], 0);
+        skewed.begin();
+        let right = skewed.split(0);
+        assert_eq!((skewed.pass.factor, right.pass.factor), (1.0, 1.0));
+        // An eighth: half the confidence.
+        let mut skewed = cell_with([350, 50, 350, 50, 350, 50, 350, 50], 0);
         skewed.begin();
         let right = skewed.split(0);
         assert_eq!((skewed.pass.factor, right.pass.factor), (1.0, 0.5));
@@ -296,16 +334,21 @@ mod tests {
     /// was kept; the count restarts and the generation moves on.
     #[test]
     fn ending_a_pass_sets_the_confidence_and_restarts_the_count() {
-        let mut c = cell_with([200, 600, 0, 0, 0, 0, 0, 0], 0);
+        let mut c = cell_with([100, 700, 0, 0, 0, 0, 0, 0], 0);
         c.begin();
         let mut upper = c.split(0);
         upper.end(true);
         assert_eq!(upper.cut.confidence(), 1.0);
         c.end(false);
         assert_eq!(c.cut.confidence(), 0.5);
-        assert_eq!((c.splats(), c.used, c.generation), (0, 400, 1));
+        assert_eq!((c.splats(), c.used, c.generation), (0, 100, 1));
         c.count(3);
         c.begin();
-        assert!(!c.pass.ready, "1 of the 600 it needs");
+        assert!(!c.pass.ready, "1 of the 150 it needs");
+        for _ in 1..150 {
+            c.count(5);
+        }
+        c.begin();
+        assert!(c.pass.ready, "150 of the 150 it needs");
     }
 }

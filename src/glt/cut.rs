@@ -3,6 +3,7 @@
 
 use super::config::CutConfig;
 use super::cut_node::{CutNode, Slot};
+use crate::error::{ConfigError, unit};
 use crate::light_tree::LightHierarchy;
 use crate::math::{Counter, Side, SumBuffer};
 use alloc::boxed::Box;
@@ -184,20 +185,32 @@ impl GuidingCut {
     /// How much of what the cut learned comes from its own cell, in
     /// `[0, 1]`. Sampling trusts the learned distribution by this much
     /// and the prior for the rest: the defensive weight becomes
-    /// `alpha + (1 - alpha) (1 - confidence)`, so a cut that learned
+    /// `1 - (1 - alpha) confidence`, so a cut that learned
     /// nothing of its own samples exactly as the prior does.
     ///
     /// A cut rebuilt from its cell's records has confidence 1. When a
-    /// cell splits, each half inherits the cut its parent learned from
-    /// records that fell mostly in one half or the other; a half whose
-    /// share `s` of those records is below an even split gets its parent's
-    /// confidence times `2 s` (a tile-order renderer that has rendered
+    /// cell splits, each half inherits the cut its parent learned, from
+    /// records that may have fallen mostly in one half; a half whose share
+    /// `s` of those records is below a quarter gets its parent's
+    /// confidence times `4 s` (a tile-order renderer that has rendered
     /// only part of a cell leaves the other half at the prior, not at
-    /// another region's choice). The spatial structures set it
-    /// ([`Glt`](super::Glt)); a cut used on its own keeps 1.
+    /// another region's choice). The crate's spatial structures set it
+    /// ([`Glt`](super::Glt), [`GuidingField`](crate::field::GuidingField));
+    /// a cut used on its own keeps 1 unless
+    /// [`GuidingCut::set_confidence`] says otherwise.
     #[inline]
     pub fn confidence(&self) -> f32 {
         self.confidence
+    }
+
+    /// Sets [`GuidingCut::confidence`], for a spatial structure of one's
+    /// own that copies a cut into a region the cut's records did not come
+    /// from (the crate's structures set it themselves). Refuses a value
+    /// outside `[0, 1]` (NaN included) and keeps the old one.
+    pub fn set_confidence(&mut self, confidence: f32) -> Result<(), ConfigError> {
+        unit("GuidingCut::confidence", f64::from(confidence))?;
+        self.confidence = confidence;
+        Ok(())
     }
 
     /// The learned fraction of each unbounded light (before the mixture

@@ -51,12 +51,12 @@ mod standalone;
 mod visibility;
 mod walk;
 
+pub use cell::GltCell;
+pub(crate) use cell::{octant_of, split_octants};
 pub use config::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
 pub use cut::{CutError, CutMemory, GuidingCut};
 pub use cut_node::{CutNode, Slot};
 pub use cut_rules::CutRules;
 pub use splat::SplatOutcome;
-pub use cell::GltCell;
-pub(crate) use cell::{octant_of, split_octants};
 pub use standalone::{Glt, GltConfig, GltMemory, GltVertex};
 pub(crate) use visibility::valid_record;

@@ -2,11 +2,11 @@
 //! [`Glt`] (`src/persist/mod.rs` has the header, `docs/format.md` the
 //! layout); merging two GLTs' statistics.
 
+use super::cell::GltCell;
 use super::config::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
 use super::cut::{GuidingCut, MIN_VISIBILITY, anchor_sums, sum_count, visibility_slots};
 use super::cut_node::CutNode;
 use super::cut_rules::CutRules;
-use super::cell::GltCell;
 use super::standalone::{Glt, GltConfig};
 use crate::dropped::DropCounters;
 use crate::light_sampler::UnboundedLights;
@@ -251,8 +251,8 @@ impl<H: LightHierarchy> Glt<H> {
         self.dropped.write(&mut w);
         self.spatial.write(&mut w, |cell, w| {
             cell.cut.write(w);
-            // Version 3: the splats per octant, the splats the last
-            // refinement used and the cell's refinement count.
+            // Version 3: the splats per octant, the splats that fell in the
+            // cell before its last refinement, its refinement count.
             for n in cell.octant_splats() {
                 w.u64(n);
             }
@@ -283,7 +283,8 @@ impl<H: LightHierarchy> Glt<H> {
                 // part in every refinement.
                 let splats = r.u64("cell: splats")?;
                 r.u64("cell: split count")?;
-                let octants = core::array::from_fn(|o| splats / 8 + u64::from((o as u64) < splats % 8));
+                let octants =
+                    core::array::from_fn(|o| splats / 8 + u64::from((o as u64) < splats % 8));
                 return Ok(GltCell::with_counts(cut, octants, 0, iteration));
             }
             let mut octants = [0u64; 8];

@@ -8,7 +8,7 @@
 //! ```
 //!
 //! with `alpha` the defensive weight raised by the cut's doubt,
-//! `alpha + (1 - alpha) (1 - confidence)` ([`GuidingCut::confidence`]: 1
+//! `1 - (1 - alpha) confidence` ([`GuidingCut::confidence`]: 1
 //! for a cut learned from its own cell, so usually `alpha` itself),
 //! where `f_i` is the cell's learned fraction of unbounded light `u_i` (of
 //! `k`, `F` their sum), `q` the user's prior probability of the unbounded
@@ -70,9 +70,13 @@ impl Mixture {
     #[inline]
     pub(crate) fn new(emitters: bool, cut: &GuidingCut, config: &CutConfig) -> Self {
         // Trust what the cut learned only as far as it learned it in its
-        // own cell (exactly `alpha` at confidence 1).
-        let doubt = 1.0 - f64::from(cut.confidence.clamp(0.0, 1.0));
-        let a = config.alpha + (1.0 - config.alpha) * doubt;
+        // own cell: exactly `alpha` at confidence 1, exactly 1 (the prior
+        // alone) at 0.
+        let a = if cut.confidence < 1.0 {
+            1.0 - (1.0 - config.alpha) * f64::from(cut.confidence)
+        } else {
+            config.alpha
+        };
         let k = cut.unbounded.len();
         if k == 0 {
             return Self {

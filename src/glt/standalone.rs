@@ -2,6 +2,7 @@
 //! without directional guiding. One [`GuidingCut`] per cell of PPG's spatial
 //! binary tree; it is itself a [`LightSampler`].
 
+use super::cell::GltCell;
 use super::config::CutConfig;
 use super::cut::{CutMemory, GuidingCut};
 use super::cut_node::CutNode;
@@ -13,13 +14,12 @@ use crate::emitter::ShadingContext;
 use crate::error::{ConfigError, Error};
 use crate::light_sampler::{LightId, LightSample, LightSampler};
 use crate::light_tree::LightHierarchy;
-use crate::math::pmf_to_f32;
 use crate::math::Aabb;
+use crate::math::pmf_to_f32;
 use crate::spatial::{
     BinaryTree, CellId, RefineOutcome, SpatialFilter, SpatialTree, jitter_offset,
 };
 use crate::spatial::{Growth, Jitter, content_scale};
-use super::cell::GltCell;
 use glam::Vec3;
 
 /// Parameters of a [`Glt`]: the cuts' and the spatial tree's.
@@ -289,8 +289,9 @@ impl<H: LightHierarchy> Glt<H> {
     /// (`&mut self`: between passes or tiles, or through
     /// [`SharedGuide`](crate::shared_guide::SharedGuide)).
     ///
-    /// A cell takes part once it holds 3/2 of the splats its last
-    /// refinement used (any, before its first; see [`GltCell`]); the others
+    /// A cell takes part once it holds 3/2 of the splats that fell in it
+    /// before its last refinement (any, before its first; see
+    /// [`GltCell`]); the others
     /// keep accumulating. A cell that takes part splits while its count is
     /// above `c sqrt(2^g)` (`c` the spatial threshold, `g` the refinements
     /// it took part in, a half taken to have half its parent's splats: PPG's

@@ -90,7 +90,9 @@ impl<H: LightHierarchy> CutRules<H> {
     /// learned nothing of its own assumes nothing is hidden.
     #[inline]
     pub(super) fn visibility_at(&self, cut: &GuidingCut, sum: Option<usize>) -> f32 {
-        let v = sum.and_then(|i| cut.visibility.get(i).copied()).unwrap_or(1.0);
+        let v = sum
+            .and_then(|i| cut.visibility.get(i).copied())
+            .unwrap_or(1.0);
         if cut.confidence >= 1.0 {
             v
         } else {

@@ -47,7 +47,8 @@
 //! it goes and calls `refine()` after every few tiles (a wave of as many
 //! tiles as it has threads, say). The GLT refines cell by cell
 //! (`glt::GltCell`): a cell takes part once it holds 3/2 of the records
-//! its last refinement used, so the cells the tiles have reached learn
+//! that fell in it before its last refinement, so the cells the tiles
+//! have reached learn
 //! while the others wait for records of their own, and a half of a cell
 //! that the records never reached falls back to the prior
 //! (`glt::GuidingCut::confidence`) instead of sampling with a choice
