@@ -450,6 +450,25 @@ fn chi_square_every_sampler() {
     }
 }
 
+/// Samplers that learn nothing report every light fully visible (the
+/// resampling target's factor is then 1), alone and with their sample.
+#[test]
+fn samplers_that_learn_nothing_see_everything() {
+    let emitters = fit_scene(64, 3);
+    let tree = LightTree::build(&emitters, BuildHeuristic::Sarh).unwrap();
+    let ctx = ShadingContext::on_surface(Vec3::new(0.5, -4.5, 0.0), Vec3::Y);
+    for (name, s) in all_samplers(&emitters, &tree, sun_and_sky(0.2)) {
+        for l in lights(emitters.len()) {
+            assert_eq!(s.visibility(&ctx, l), 1.0, "{name}: {l:?}");
+        }
+        for k in 0..100 {
+            let u = k as f32 / 100.0;
+            let with = s.sample_with_visibility(&ctx, u);
+            assert_eq!(with, s.sample(&ctx, u).map(|x| (x, 1.0)), "{name}");
+        }
+    }
+}
+
 /// The test above can fail: a distribution 10% off on one light is
 /// rejected.
 #[test]

@@ -223,6 +223,33 @@ mod tests {
     }
 
     #[test]
+    fn reports_its_size() {
+        let s = PowerSampler::from_powers([1.0, 0.0, 2.0]);
+        assert_eq!((s.len(), s.is_empty()), (3, false));
+        assert_eq!(core::mem::size_of::<Bin>(), 16);
+        assert_eq!(s.bytes(), 48);
+    }
+
+    /// A light whose pmf rounds to 0 in `f32` is never returned, also
+    /// where its slot's threshold is met (`u = 0`: `x - slot = 0` is below
+    /// any positive threshold).
+    #[test]
+    fn a_pmf_that_rounds_to_zero_is_never_sampled() {
+        let s = PowerSampler::from_powers([1e-30, 1e30]);
+        let ctx = ShadingContext::at(Vec3::ZERO);
+        assert_eq!(s.pmf(&ctx, LightId::Emitter(0)), 0.0);
+        assert!(
+            s.bins[0].threshold > 0.0,
+            "the tiny light keeps its slot share"
+        );
+        assert_eq!(s.sample(&ctx, 0.0), None);
+        for k in 1..1000 {
+            let x = s.sample(&ctx, k as f32 / 1000.0).unwrap();
+            assert_eq!((x.light, x.pmf), (LightId::Emitter(1), 1.0));
+        }
+    }
+
+    #[test]
     fn never_picks_zero_power() {
         let mut powers = alloc::vec![0.0f32; 1000];
         powers[17] = 1.0;

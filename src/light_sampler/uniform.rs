@@ -67,7 +67,7 @@ impl LightSampler for UniformSampler {
 
     #[inline]
     fn is_empty(&self) -> bool {
-        self.count == 0 || self.pmf == 0.0
+        self.count == 0
     }
 }
 
@@ -91,6 +91,20 @@ mod tests {
         assert_eq!(s.pmf(&ctx, LightId::Emitter(3)), 0.25);
         assert_eq!(s.pmf(&ctx, LightId::Emitter(4)), 0.0);
         assert_eq!(s.pmf(&ctx, LightId::Unbounded(0)), 0.0);
+    }
+
+    /// Counts are capped at the 2^32 ids a `LightId::Emitter` holds, and
+    /// the last of them is reachable.
+    #[test]
+    #[cfg(target_pointer_width = "64")]
+    fn counts_beyond_the_ids_are_capped() {
+        let ctx = ShadingContext::at(Vec3::ZERO);
+        assert_eq!(UniformSampler::new(5).count(), 5);
+        let s = UniformSampler::new(usize::MAX);
+        assert_eq!(s.count(), 1 << 32);
+        assert_eq!(s.pmf(&ctx, LightId::Emitter(u32::MAX)), 2f32.powi(-32));
+        let last = s.sample(&ctx, 1.0).unwrap().light;
+        assert_eq!(last, LightId::Emitter(u32::MAX));
     }
 
     #[test]
