@@ -195,15 +195,7 @@ pub fn run() -> bool {
     let tree = LightTree::build(&emitters, BuildHeuristic::default()).expect("valid lights");
     // 3. The GLT over the region shading points live in.
     let bounds = Aabb::new(Vec3::new(-4.0, 0.0, -2.0), Vec3::new(4.0, 2.0, 2.0));
-    let mut glt = Glt::new(
-        &tree,
-        bounds,
-        GltConfig {
-            spatial_threshold: 256.0,
-            ..GltConfig::default()
-        },
-    )
-    .expect("finite bounds");
+    let mut glt = Glt::new(&tree, bounds, GltConfig::default()).expect("finite bounds");
     let points: Vec<Vec3> = (0..64)
         .map(|i| {
             let x = 0.5 + 3.5 * ((i / 2) % 8) as f32 / 7.0;

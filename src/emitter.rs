@@ -236,13 +236,13 @@ emitters_for_list!([Emitter], alloc::vec::Vec<Emitter>);
 pub struct ShadingContext {
     /// World-space position.
     pub position: Vec3,
-    /// Unit surface normal on the side light is gathered from; `None` in
-    /// media, on surfaces that transmit (light arrives from both sides), or
-    /// when unknown. Importance-based samplers give lights behind it
-    /// nothing, so for an opaque surface it must face the outgoing
-    /// direction: a geometric or shading normal that points into the
-    /// surface makes every light in front of it look unreachable (see
-    /// [`ShadingContext::facing`]).
+    /// Unit surface normal, `None` in media or when unknown: the shading
+    /// normal, the one in the cosine of the renderer's estimator.
+    /// Importance-based samplers discount a light by a conservative bound
+    /// on `|cos|` to it, so its sign does not matter (a light behind the
+    /// surface counts as one in front: transmission), and a light gets
+    /// nothing from it only when all of it lies exactly in the tangent
+    /// plane, where that cosine is 0 (see [`crate::light_sampler::importance`]).
     pub normal: Option<Vec3>,
 }
 
@@ -255,8 +255,9 @@ impl ShadingContext {
         }
     }
 
-    /// A context on a surface whose `normal` already faces the side light
-    /// is gathered from (see [`ShadingContext::normal`]).
+    /// A context on a surface with `normal` (see
+    /// [`ShadingContext::normal`]; normalised here, a zero or non-finite
+    /// one counts as none).
     pub fn on_surface(position: Vec3, normal: Vec3) -> Self {
         Self {
             position,
@@ -264,9 +265,11 @@ impl ShadingContext {
         }
     }
 
-    /// A context on an opaque surface: `normal` is flipped, if needed, to
-    /// the side of the outgoing direction `wo` (towards the viewer), as
-    /// renderers that keep normals as the mesh defines them need.
+    /// A context on a surface whose `normal` is flipped, if needed, to the
+    /// side of the outgoing direction `wo` (towards the viewer). The
+    /// crate's samplers do not need it (they use `|cos|`); a custom
+    /// [`LightHierarchy`](crate::LightHierarchy) whose importance is
+    /// one-sided would.
     ///
     /// ```
     /// use guiding::{glam::Vec3, ShadingContext};

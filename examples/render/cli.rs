@@ -124,8 +124,9 @@ pub struct Args {
     #[arg(long, default_value_t = 4000.0)]
     pub spatial_threshold: f64,
     /// The same threshold for the GLT's own spatial tree (`pt-glt`), which
-    /// counts light splats: finer cells pay off there.
-    #[arg(long, default_value_t = 250.0)]
+    /// counts light splats: finer cells pay off there (the library's
+    /// default).
+    #[arg(long, default_value_t = guiding::glt::GltConfig::default().spatial_threshold)]
     pub glt_spatial_threshold: f64,
     /// Method that renders references: unbiased and unguided by default,
     /// so that no compared guided method is measured against its own

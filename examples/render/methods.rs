@@ -138,7 +138,7 @@ impl Default for GuideParams {
         Self {
             sigma: cut.sigma,
             spatial_threshold: 4000.0,
-            glt_spatial_threshold: 250.0,
+            glt_spatial_threshold: guiding::glt::GltConfig::default().spatial_threshold,
             below_cut: cut.below_cut,
             min_splats: cut.min_splats,
             alpha: cut.alpha,

@@ -48,11 +48,12 @@
 //! tiles as it has threads, say). The GLT refines cell by cell
 //! (`glt::GltCell`): a cell takes part once it holds 3/2 of the records
 //! that fell in it before its last refinement, so the cells the tiles
-//! have reached learn
-//! while the others wait for records of their own, and a half of a cell
-//! that the records never reached falls back to the prior
+//! have reached learn while the others wait for records of their own, and
+//! a half of a cell that the records never reached falls back to the prior
 //! (`glt::GuidingCut::confidence`) instead of sampling with a choice
-//! learned elsewhere.
+//! learned elsewhere. (The field's cells refine on PPG's clock, every
+//! refinement, as its SD-tree needs; their halves fall back to the prior
+//! as the GLT's do.)
 //!
 //! Zero-valued records (an occluded shadow ray, a path that found no light)
 //! are valid observations everywhere in the crate: they add nothing to the
