@@ -206,10 +206,8 @@ impl<S: LightSampler> LightSampler for WithUnbounded<S> {
                 pmf_to_f32(pu / f64::from(self.unbounded.count))
             }
             LightId::Unbounded(_) => 0.0,
-            LightId::Emitter(_) if pe > 0.0 => {
-                pmf_to_f32(pe * f64::from(self.inner.pmf(ctx, light)))
-            }
-            LightId::Emitter(_) => 0.0,
+            // An empty inner sampler has `pe` 0 and every pmf 0.
+            LightId::Emitter(_) => pmf_to_f32(pe * f64::from(self.inner.pmf(ctx, light))),
         }
     }
 
@@ -231,6 +229,48 @@ mod tests {
             UnboundedLights::new(count, p).unwrap(),
         )
         .unwrap()
+    }
+
+    /// An inner sampler that always draws emitter 0 with the smallest
+    /// positive `f32` pmf.
+    struct Tiny;
+
+    impl LightSampler for Tiny {
+        fn sample(&self, _: &ShadingContext, _: f32) -> Option<LightSample> {
+            Some(LightSample {
+                light: LightId::Emitter(0),
+                pmf: f32::from_bits(1),
+            })
+        }
+        fn pmf(&self, _: &ShadingContext, light: LightId) -> f32 {
+            match light {
+                LightId::Emitter(0) => f32::from_bits(1),
+                _ => 0.0,
+            }
+        }
+        fn is_empty(&self) -> bool {
+            false
+        }
+    }
+
+    /// A light whose wrapped pmf rounds to 0 in `f32` is never drawn, and
+    /// the wrapper reports the unbounded lights it was given.
+    #[test]
+    fn a_pmf_that_rounds_to_zero_is_never_sampled() {
+        let ctx = ShadingContext::at(Vec3::ZERO);
+        let lights = UnboundedLights::new(1, 0.5).unwrap();
+        let s = WithUnbounded::new(Tiny, lights).unwrap();
+        assert_eq!(s.unbounded(), lights);
+        assert_eq!(
+            s.pmf(&ctx, LightId::Emitter(0)),
+            0.0,
+            "half the smallest f32"
+        );
+        assert_eq!(s.sample(&ctx, 0.75), None);
+        assert_eq!(
+            s.sample(&ctx, 0.25).map(|x| x.light),
+            Some(LightId::Unbounded(0))
+        );
     }
 
     #[test]
