@@ -6,6 +6,9 @@
 //! The heuristics take the pdfs of the two techniques for the same sample,
 //! in the same measure (solid angle).
 
+use crate::path_recorder::luminance;
+use glam::Vec3;
+
 /// Veach's power heuristic (beta = 2), the weight of technique `a` against
 /// `b`: `a^2 / (a^2 + b^2)`, squared in `f64` so that neither tiny nor huge
 /// pdfs underflow or overflow. An infinite `a` (a delta technique) gets 1,
@@ -78,12 +81,61 @@ pub struct DirectLight {
     pub factor: f32,
 }
 
+/// What one direct-light sample adds to the path and what it records
+/// for the light it reached ([`DirectLight::estimate`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirectEstimate {
+    /// Added to the path's radiance at the vertex (before the path's
+    /// throughput): `f_cos * le * factor`, 0 when occluded.
+    pub contribution: Vec3,
+    /// The value to record for the light (`splat` / `splat_light`):
+    /// `luminance(le) * factor`, 0 when occluded (record it, or record
+    /// nothing: the schedule module's rule on zero-valued records).
+    pub record: f32,
+}
+
 impl DirectLight {
     /// Nothing: a sample that cannot count.
     pub const NONE: Self = Self {
         weight: 0.0,
         factor: 0.0,
     };
+
+    /// The sample's contribution and record in one call, from the light's
+    /// arriving radiance `le` (linear Rec. 709 RGB), `f_cos` (the BSDF
+    /// value times the cosine, RGB) and whether the shadow ray found the
+    /// light unoccluded. A renderer whose estimator returns only the
+    /// weighted contribution (pbrt-v3's `EstimateDirect`) calls this for
+    /// its light sample and its BSDF sample and sums the contributions.
+    /// A non-finite result counts as nothing (both 0).
+    ///
+    /// ```
+    /// use guiding::glam::Vec3;
+    /// use guiding::mis::Convention;
+    /// // A light chosen with pmf 0.25, its point sampled with solid-angle
+    /// // pdf 2, the BSDF sampling that direction with pdf 0.5.
+    /// let d = Convention::PbrtV4.light_sample(0.25, 2.0, 0.5);
+    /// let e = d.estimate(Vec3::splat(3.0), Vec3::splat(0.1), true);
+    /// assert_eq!(e.contribution, Vec3::splat(0.1 * 3.0) * d.factor);
+    /// assert_eq!(e.record, 3.0 * d.factor);
+    /// assert_eq!(d.estimate(Vec3::splat(3.0), Vec3::splat(0.1), false).record, 0.0);
+    /// ```
+    #[inline]
+    pub fn estimate(self, le: Vec3, f_cos: Vec3, visible: bool) -> DirectEstimate {
+        let contribution = f_cos * le * self.factor;
+        let record = luminance(le) * self.factor;
+        if visible && contribution.is_finite() && record.is_finite() {
+            DirectEstimate {
+                contribution,
+                record,
+            }
+        } else {
+            DirectEstimate {
+                contribution: Vec3::ZERO,
+                record: 0.0,
+            }
+        }
+    }
 
     /// `weight / (a * b)` in `f64`, 0 when not finite or not positive.
     #[inline]
@@ -169,6 +221,26 @@ pub fn resampled_light_sample(pmf: f32, weight: f32, pdf_light: f32, pdf_bsdf: f
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The contribution is `f_cos le factor` per channel, the record the
+    /// luminance of `le` times the factor; occluded or non-finite, both 0.
+    #[test]
+    fn an_estimate_is_its_contribution_and_its_record() {
+        let d = Convention::PbrtV3.bsdf_sample(0.5, 1.0, 2.0);
+        let (le, f) = (Vec3::new(1.0, 2.0, 4.0), Vec3::new(0.5, 0.25, 0.125));
+        let e = d.estimate(le, f, true);
+        assert_eq!(e.contribution, Vec3::splat(0.5 * d.factor));
+        assert_eq!(e.record, luminance(le) * d.factor);
+        assert!(e.record > 0.0);
+        let nothing = DirectEstimate {
+            contribution: Vec3::ZERO,
+            record: 0.0,
+        };
+        assert_eq!(d.estimate(le, f, false), nothing);
+        assert_eq!(d.estimate(Vec3::splat(f32::NAN), f, true), nothing);
+        assert_eq!(d.estimate(le, Vec3::splat(f32::INFINITY), true), nothing);
+        assert_eq!(DirectLight::NONE.estimate(le, f, true), nothing);
+    }
 
     #[test]
     fn weights_sum_to_one_and_edges_are_defined() {
