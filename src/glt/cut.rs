@@ -191,8 +191,8 @@ impl GuidingCut {
     /// A cut rebuilt from its cell's records has confidence 1. When a
     /// cell splits, each half inherits the cut its parent learned, from
     /// records that may have fallen mostly in one half; a half whose share
-    /// `s` of those records is below a quarter gets its parent's
-    /// confidence times `4 s` (a tile-order renderer that has rendered
+    /// `s` of those records is below a twentieth gets its parent's
+    /// confidence times `20 s` (a tile-order renderer that has rendered
     /// only part of a cell leaves the other half at the prior, not at
     /// another region's choice). The crate's spatial structures set it
     /// ([`Glt`](super::Glt), [`GuidingField`](crate::field::GuidingField));
