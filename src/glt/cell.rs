@@ -100,7 +100,7 @@ pub(super) struct Pass {
     /// (PPG's rule).
     pub(super) count: u64,
     /// The confidence its cut keeps from this pass's splits: the product
-    /// of `min(1, 2 share)` over them.
+    /// of `min(1, share / TRUSTED_SHARE)` over them.
     pub(super) factor: f32,
 }
 
