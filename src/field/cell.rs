@@ -1,7 +1,6 @@
 //! What one cell of the guiding field holds.
 
-use crate::glt::{GuidingCut, split_octants};
-use crate::math::Counter;
+use crate::glt::{GuidingCut, OctantSplats};
 use crate::sd_tree::SdCell;
 
 /// One cell of a [`GuidingField`](super::GuidingField): an SD-tree cell
@@ -15,7 +14,7 @@ pub struct FieldCell {
     pub(super) cut: GuidingCut,
     /// Light splats since the last refinement per octant of the cell (as
     /// [`GltCell`](crate::glt::GltCell) counts them).
-    pub(super) octants: [Counter; 8],
+    pub(super) octants: OctantSplats,
 }
 
 impl FieldCell {
@@ -33,39 +32,27 @@ impl FieldCell {
 
     /// A cell with `sd` and `cut`, no light splat counted.
     pub(super) fn new(sd: SdCell, cut: GuidingCut) -> Self {
-        Self::with_counts(sd, cut, [0; 8])
+        Self::with_counts(sd, cut, OctantSplats::default())
     }
 
     /// A cell with `sd`, `cut` and the light splats counted per octant.
-    pub(super) fn with_counts(sd: SdCell, cut: GuidingCut, octants: [u64; 8]) -> Self {
-        Self {
-            sd,
-            cut,
-            octants: octants.map(Counter::with),
-        }
+    pub(super) fn with_counts(sd: SdCell, cut: GuidingCut, octants: OctantSplats) -> Self {
+        Self { sd, cut, octants }
     }
 
     /// Light splats since the last refinement, per octant of the cell.
     pub fn octant_splats(&self) -> [u64; 8] {
-        core::array::from_fn(|o| self.octants[o].get())
+        self.octants.get()
     }
 
     /// Splits the light splats' counts between this cell (the lower half
     /// along `axis`) and `upper`, a copy of it, scaling each cut's
     /// confidence by its half's share.
     pub(super) fn share_split(&mut self, upper: &mut Self, axis: usize) {
-        let [(lower, lower_factor), (up, up_factor)] = split_octants(self.octant_splats(), axis);
-        self.octants = lower.map(Counter::with);
+        let (counts, lower_factor, upper_factor) = self.octants.split(axis);
+        upper.octants = counts;
         self.cut.confidence *= lower_factor;
-        upper.octants = up.map(Counter::with);
-        upper.cut.confidence *= up_factor;
-    }
-
-    /// Zeroes the light splat counts.
-    pub(super) fn reset_counts(&mut self) {
-        for c in &mut self.octants {
-            c.reset();
-        }
+        upper.cut.confidence *= upper_factor;
     }
 
     /// Bytes the cell owns on the heap: the quadtree's copies, the SD sums

@@ -198,7 +198,7 @@ impl<H: LightHierarchy> GuidingField<H> {
             FieldCell::heap_bytes,
         );
         for cell in self.cells.data_slice_mut() {
-            cell.reset_counts();
+            cell.octants.reset();
         }
         outcome
     }
@@ -264,7 +264,7 @@ impl<H: LightHierarchy> GuidingField<H> {
         let outcome = self
             .guide
             .splat_spread(&self.cells, (p, at), light, value, filter, |cell| {
-                cell.octants[octant].bump();
+                cell.octants.count(octant);
             });
         if outcome == SplatOutcome::Dropped {
             self.sd.dropped.count(DropReason::Light);

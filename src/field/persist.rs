@@ -2,7 +2,7 @@
 //! statistics.
 
 use super::{FieldCell, GuidingField};
-use crate::glt::{CutConfig, CutRules, GuidingCut};
+use crate::glt::{CutConfig, CutRules, GuidingCut, OctantSplats};
 use crate::light_tree::LightHierarchy;
 use crate::persist::{
     FILTERS, Kind, LoadError, Reader, Writer, config_error, fingerprint, read_fingerprint, tag,
@@ -26,9 +26,7 @@ impl<H: LightHierarchy> GuidingField<H> {
             cell.sd.write(w);
             cell.cut.write(w);
             // Version 3: the light splats per octant.
-            for n in cell.octant_splats() {
-                w.u64(n);
-            }
+            cell.octants.write(w);
         });
         w.finish(Kind::Field)
     }
@@ -48,12 +46,10 @@ impl<H: LightHierarchy> GuidingField<H> {
         let cells = BinaryTree::read(&mut r, |r| {
             let sd_cell = SdCell::read(r, &sd.config)?;
             let cut = GuidingCut::read(r, &guide)?;
-            let mut octants = [0u64; 8];
-            if r.version() >= 3 {
-                for n in &mut octants {
-                    *n = r.u64("cell: octant light splats")?;
-                }
-            }
+            let octants = match r.version() {
+                3.. => OctantSplats::read(r, "cell: octant light splats")?,
+                _ => OctantSplats::default(),
+            };
             Ok(FieldCell::with_counts(sd_cell, cut, octants))
         })?;
         r.end()?;
@@ -72,7 +68,7 @@ impl<H: LightHierarchy> GuidingField<H> {
         for cell in self.cells.data_slice_mut() {
             cell.sd.clear_records();
             cell.cut.clear_records();
-            cell.reset_counts();
+            cell.octants.reset();
         }
         self.sd.dropped.reset();
     }
@@ -105,9 +101,7 @@ impl<H: LightHierarchy> GuidingField<H> {
         {
             a.sd.merge(&b.sd);
             a.cut.merge(&b.cut);
-            for (x, y) in a.octants.iter_mut().zip(&b.octants) {
-                x.merge(y);
-            }
+            a.octants.merge(&b.octants);
         }
         true
     }

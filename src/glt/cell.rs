@@ -19,59 +19,13 @@
 //! never reached, until it refines on records of its own.
 
 use super::cut::GuidingCut;
-use crate::math::{Aabb, Counter};
+use super::octants::OctantSplats;
 use crate::spatial::split_threshold;
-use glam::Vec3;
 
 /// A cell takes part in a refinement once it has collected
 /// `READY_NUM / READY_DEN` times the splats that fell in it before its last.
 const READY_NUM: u64 = 3;
 const READY_DEN: u64 = 2;
-
-/// The octant of a cell with `bounds` that `p` falls in: bit 0 set for
-/// `x` at or above the centre, bit 1 for `y`, bit 2 for `z` (a point
-/// outside counts in the nearest).
-#[inline]
-pub(crate) fn octant_of(p: Vec3, bounds: &Aabb) -> usize {
-    let c = bounds.center();
-    usize::from(p.x >= c.x) | usize::from(p.y >= c.y) << 1 | usize::from(p.z >= c.z) << 2
-}
-
-/// A half of a split cell that holds at least this share of the records
-/// its parent's cut learned from keeps the cut's confidence; below it the
-/// confidence falls in proportion, to 0 for a half no record came from.
-/// Small: a cut a twentieth of whose records came from a half still serves
-/// it better than the prior, and in pass order the halves split by the
-/// last refinement sample with what they inherit for the longest
-/// iteration (at 0.25 the GLT's variance on `city` rose by up to 10%; at
-/// 0.05 it is main's; docs/experiments/tile-order.md). What it guards
-/// against is a half that got nothing: a region not rendered yet.
-pub(crate) const TRUSTED_SHARE: f64 = 0.05;
-
-/// Splits per-octant counts `counts` of a cell halved along `axis` (0,
-/// 1, 2): each half's octant counts (along `axis` its own octants are not
-/// known: the count is shared evenly) and its confidence factor, `min(1,
-/// share / TRUSTED_SHARE)` of the records (1 when there are none). Lower
-/// half first.
-pub(crate) fn split_octants(counts: [u64; 8], axis: usize) -> [([u64; 8], f32); 2] {
-    let bit = 1usize << axis;
-    let total: u64 = counts.iter().sum();
-    let mut halves = [[0u64; 8]; 2];
-    for (o, &n) in counts.iter().enumerate() {
-        let half = &mut halves[usize::from(o & bit != 0)];
-        half[o & !bit] += n / 2;
-        half[o | bit] += n - n / 2;
-    }
-    halves.map(|half| {
-        let factor = if total == 0 {
-            1.0
-        } else {
-            let share = half.iter().sum::<u64>() as f64 / total as f64;
-            (share / TRUSTED_SHARE).min(1.0) as f32
-        };
-        (half, factor)
-    })
-}
 
 /// One cell of a [`Glt`](super::Glt): its cut and what decides its
 /// refinement.
@@ -81,7 +35,7 @@ pub struct GltCell {
     /// Splats (zero values included) since the cell last took part in a
     /// refinement, per octant of the cell: bit 0 set for `x` at or above
     /// the cell's centre, bit 1 for `y`, bit 2 for `z`.
-    pub(super) octants: [Counter; 8],
+    pub(super) octants: OctantSplats,
     /// The splats that fell in the cell before its last refinement (its
     /// share of them, for a half born of a split; 0 before the first).
     pub(super) used: u64,
@@ -124,19 +78,19 @@ impl AsRef<GuidingCut> for GltCell {
 impl GltCell {
     /// A cell with `cut`, nothing recorded.
     pub(super) fn new(cut: GuidingCut) -> Self {
-        Self::with_counts(cut, [0; 8], 0, 0)
+        Self::with_counts(cut, OctantSplats::default(), 0, 0)
     }
 
     /// A cell with `cut` and the given counts (a loaded one).
     pub(super) fn with_counts(
         cut: GuidingCut,
-        octants: [u64; 8],
+        octants: OctantSplats,
         used: u64,
         generation: u32,
     ) -> Self {
         Self {
             cut,
-            octants: octants.map(Counter::with),
+            octants,
             used,
             generation,
             pass: Pass::default(),
@@ -153,32 +107,20 @@ impl GltCell {
     /// part in a refinement.
     #[inline]
     pub fn splats(&self) -> u64 {
-        self.octant_splats().iter().sum()
+        self.octants.total()
     }
 
     /// [`GltCell::splats`] per octant of the cell (bit 0 of the index set
     /// for `x` at or above the cell's centre, bit 1 for `y`, bit 2 for
     /// `z`).
     pub fn octant_splats(&self) -> [u64; 8] {
-        core::array::from_fn(|o| self.octants[o].get())
+        self.octants.get()
     }
 
     /// Refinements the cell took part in (a half counts its parent's).
     #[inline]
     pub fn generation(&self) -> u32 {
         self.generation
-    }
-
-    /// [`octant_of`].
-    #[inline]
-    pub(super) fn octant(p: Vec3, bounds: &Aabb) -> usize {
-        octant_of(p, bounds)
-    }
-
-    /// Counts a splat from `octant`.
-    #[inline]
-    pub(super) fn count(&self, octant: usize) {
-        self.octants[octant & 7].bump();
     }
 
     /// Starts a refinement: the cell takes part if it has 3/2 of the
@@ -204,13 +146,11 @@ impl GltCell {
     /// octants are not known: the count is shared evenly), its share of
     /// the records as a confidence factor, and half the split count.
     pub(super) fn split(&mut self, axis: usize) -> Self {
-        let [(lower, lower_factor), (upper_counts, upper_factor)] =
-            split_octants(self.octant_splats(), axis);
         self.pass.count /= 2;
         let mut upper = self.clone();
-        self.octants = lower.map(Counter::with);
+        let (counts, lower_factor, upper_factor) = self.octants.split(axis);
+        upper.octants = counts;
         self.pass.factor *= lower_factor;
-        upper.octants = upper_counts.map(Counter::with);
         upper.pass.factor *= upper_factor;
         upper
     }
@@ -231,9 +171,7 @@ impl GltCell {
         // got few of its parent's records refines again on few of its own.
         self.used = self.splats();
         self.generation = self.generation.saturating_add(1);
-        for c in &mut self.octants {
-            c.reset();
-        }
+        self.octants.reset();
         self.pass = Pass::default();
     }
 }
@@ -244,6 +182,7 @@ mod tests {
     use crate::emitter::Emitter;
     use crate::glt::{CutConfig, CutRules};
     use crate::light_tree::{BuildHeuristic, LightTree};
+    use glam::Vec3;
 
     fn cell_with(octants: [u64; 8], used: u64) -> GltCell {
         let lights = [
@@ -252,26 +191,7 @@ mod tests {
         ];
         let tree = LightTree::build(&lights[..], BuildHeuristic::Sarh).unwrap();
         let rules = CutRules::new(&tree, CutConfig::default()).unwrap();
-        GltCell::with_counts(rules.new_cut(), octants, used, 0)
-    }
-
-    #[test]
-    fn a_point_counts_in_its_octant() {
-        let b = Aabb::new(Vec3::ZERO, Vec3::splat(2.0));
-        assert_eq!(GltCell::octant(Vec3::splat(0.5), &b), 0);
-        assert_eq!(GltCell::octant(Vec3::new(1.5, 0.5, 0.5), &b), 1);
-        assert_eq!(GltCell::octant(Vec3::new(0.5, 1.5, 0.5), &b), 2);
-        assert_eq!(GltCell::octant(Vec3::new(0.5, 0.5, 1.5), &b), 4);
-        assert_eq!(
-            GltCell::octant(Vec3::splat(1.0), &b),
-            7,
-            "the centre counts above"
-        );
-        assert_eq!(
-            GltCell::octant(Vec3::splat(-5.0), &b),
-            0,
-            "outside: the nearest"
-        );
+        GltCell::with_counts(rules.new_cut(), OctantSplats::with(octants), used, 0)
     }
 
     /// A cell takes part once it has 3/2 of what its last refinement
@@ -345,11 +265,11 @@ mod tests {
         c.end(false);
         assert_eq!(c.cut.confidence(), 0.5);
         assert_eq!((c.splats(), c.used, c.generation), (0, 10, 1));
-        c.count(3);
+        c.octants.count(3);
         c.begin();
         assert!(!c.pass.ready, "1 of the 15 it needs");
         for _ in 1..15 {
-            c.count(5);
+            c.octants.count(5);
         }
         c.begin();
         assert!(c.pass.ready, "15 of the 15 it needs");

@@ -7,6 +7,7 @@ use super::config::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
 use super::cut::{GuidingCut, MIN_VISIBILITY, anchor_sums, sum_count, visibility_slots};
 use super::cut_node::CutNode;
 use super::cut_rules::CutRules;
+use super::octants::OctantSplats;
 use super::standalone::{Glt, GltConfig};
 use crate::dropped::DropCounters;
 use crate::light_sampler::UnboundedLights;
@@ -253,9 +254,7 @@ impl<H: LightHierarchy> Glt<H> {
             cell.cut.write(w);
             // Version 3: the splats per octant, the splats that fell in the
             // cell before its last refinement, its refinement count.
-            for n in cell.octant_splats() {
-                w.u64(n);
-            }
+            cell.octants.write(w);
             w.u64(cell.used);
             w.u32(cell.generation);
         });
@@ -283,14 +282,12 @@ impl<H: LightHierarchy> Glt<H> {
                 // part in every refinement.
                 let splats = r.u64("cell: splats")?;
                 r.u64("cell: split count")?;
-                let octants =
-                    core::array::from_fn(|o| splats / 8 + u64::from((o as u64) < splats % 8));
+                let octants = OctantSplats::with(core::array::from_fn(|o| {
+                    splats / 8 + u64::from((o as u64) < splats % 8)
+                }));
                 return Ok(GltCell::with_counts(cut, octants, 0, iteration));
             }
-            let mut octants = [0u64; 8];
-            for n in &mut octants {
-                *n = r.u64("cell: octant splats")?;
-            }
+            let octants = OctantSplats::read(r, "cell: octant splats")?;
             let used = r.u64("cell: splats used")?;
             let generation = r.u32("cell: generation")?;
             Ok(GltCell::with_counts(cut, octants, used, generation))
@@ -311,9 +308,7 @@ impl<H: LightHierarchy> Glt<H> {
     pub fn clear_records(&mut self) {
         for cell in self.spatial.data_slice_mut() {
             cell.cut.clear_records();
-            for c in &mut cell.octants {
-                c.reset();
-            }
+            cell.octants.reset();
         }
         self.dropped.reset();
     }
@@ -351,9 +346,7 @@ impl<H: LightHierarchy> Glt<H> {
         let cells = self.spatial.data_slice_mut();
         for (a, b) in cells.iter_mut().zip(other.spatial.data_slice()) {
             a.cut.merge(&b.cut);
-            for (x, y) in a.octants.iter_mut().zip(&b.octants) {
-                x.merge(y);
-            }
+            a.octants.merge(&b.octants);
         }
         self.dropped.merge(&other.dropped);
         true

@@ -7,6 +7,7 @@ use super::config::CutConfig;
 use super::cut::{CutMemory, GuidingCut};
 use super::cut_node::CutNode;
 use super::cut_rules::CutRules;
+use super::octants::octant_of;
 use super::splat::SplatOutcome;
 use super::visibility::valid_record;
 use crate::dropped::{DropCounters, DropReason, DroppedSplats};
@@ -233,14 +234,14 @@ impl<H: LightHierarchy> Glt<H> {
         filter: SpatialFilter,
         jitter: impl FnOnce() -> Vec3,
     ) -> SplatOutcome {
-        let octant = at.map_or(0, |(_, bounds)| GltCell::octant(p, &bounds));
+        let octant = at.map_or(0, |(_, bounds)| octant_of(p, &bounds));
         let outcome = self.guide.splat_spread(
             &self.spatial,
             (p, at),
             light,
             value,
             (filter, jitter),
-            |cell| cell.count(octant),
+            |cell| cell.octants.count(octant),
         );
         if outcome == SplatOutcome::Dropped {
             self.reject();
