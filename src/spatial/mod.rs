@@ -13,8 +13,8 @@
 //!
 //! Shared by everything that learns per cell: [`BinaryTree::spread`] spreads
 //! a record made at a point over cells by a [`SpatialFilter`], and
-//! [`BinaryTree::split_by_weight`] with [`split_threshold`] is PPG's split
-//! rule (`c * sqrt(2^k)`).
+//! [`split_threshold`] is PPG's split rule (`c * sqrt(2^k)`), which the
+//! structures apply through [`BinaryTree::refine_with_heap`].
 //!
 //! Lookups clamp points outside the root cube onto it and reject non-finite
 //! points with `None`; nothing in here panics on bad input. Depth is only

@@ -1,7 +1,6 @@
 //! Practical Path Guiding's spatial split rule, shared by every structure
-//! that refines a [`BinaryTree`] by the number of records its cells took.
-
-use super::{BinaryTree, RefineOutcome};
+//! that refines a [`BinaryTree`](super::BinaryTree) by the number of
+//! records its cells took.
 
 /// PPG's spatial split threshold after iteration `k` (counted from 0):
 /// `c * sqrt(2^k)`, computed in `f64` as `c * 2^(k/2)` (times `sqrt 2` for
@@ -24,33 +23,6 @@ pub fn split_threshold(c: f64, k: u32) -> f64 {
         1.0
     };
     c * even * odd
-}
-
-impl<T: Clone> BinaryTree<T> {
-    /// PPG's spatial refinement: splits every cell whose `weight` (the
-    /// statistical weight it collected) is above `threshold`; the cell is
-    /// first given `halve`, then both children hold a copy of it (the upper
-    /// one a clone), and both are asked again, so one pass can split a cell
-    /// several levels deep. `heap_bytes` and `max_bytes` are those of
-    /// [`BinaryTree::refine_with_heap`].
-    pub fn split_by_weight(
-        &mut self,
-        threshold: f64,
-        mut weight: impl FnMut(&T) -> f64,
-        mut halve: impl FnMut(&mut T),
-        heap_bytes: impl FnMut(&T) -> usize,
-        max_bytes: Option<usize>,
-    ) -> RefineOutcome {
-        self.refine_with_heap(
-            |cell, _| weight(cell) > threshold,
-            |cell| {
-                halve(cell);
-                cell.clone()
-            },
-            heap_bytes,
-            max_bytes,
-        )
-    }
 }
 
 #[cfg(test)]
