@@ -276,6 +276,24 @@ mod tests {
     use crate::light_sampler::importance::importance as exact;
     use crate::light_tree::{BuildHeuristic, LightTree};
 
+    /// Rounding up to bfloat16 keeps values it can represent exactly and
+    /// moves every other one to the next code above: the stored cones are
+    /// never narrower than the tree's, and no wider than they must be.
+    #[test]
+    fn bf16_rounds_up_only_what_it_cannot_hold() {
+        for x in [0.0f32, 0.5, 1.0, 1.5, 2.0, 0.25, 0.0078125] {
+            assert_eq!(from_bf16(bf16_up(x)), x, "{x} is a bfloat16");
+        }
+        for x in [1.0f32 + f32::EPSILON, 0.3, 1.999, 1e-7] {
+            let up = from_bf16(bf16_up(x));
+            let below = f32::from_bits(up.to_bits() - (1 << 16));
+            assert!(up > x && below < x, "{x} rounds up to {up}");
+        }
+        // Out of range is clamped to [0, 2].
+        assert_eq!(from_bf16(bf16_up(-1.0)), 0.0);
+        assert_eq!(from_bf16(bf16_up(7.0)), 2.0);
+    }
+
     /// The table's importance follows the exact `f64` bound: never below
     /// it by more than f32 rounding (it stays conservative, so a node the
     /// exact bound lets contribute is never dropped), within 1% for 99% of
