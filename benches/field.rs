@@ -13,21 +13,21 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
+use guiding::RecordOutcome;
 use guiding::field::{FieldConfig, GuidingField};
-use guiding::glt::{Glt, GltConfig, SplatOutcome};
+use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Aabb;
 use guiding::quadtree::UNIFORM_PDF;
 use guiding::sd_tree::{SdTree, SdTreeConfig};
 use guiding::spatial::SpatialTree;
 use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
-use rand_pcg::Pcg64Mcg;
-use rand_pcg::rand_core::SeedableRng;
 use std::hint::black_box;
 
 #[path = "../tests/common/mod.rs"]
 mod common;
 use common::Rand;
+use common::{ByPosition, DirectionsAt, LightsAt};
 
 const LIGHTS: usize = 10_000;
 const QUERIES: usize = 4096;
@@ -110,27 +110,22 @@ fn train<'a>(lights: &[Emitter], tree: &'a LightTree) -> Trained<'a> {
         for _ in 0..(50_000usize << k) {
             let r = record(lights, &mut rng);
             let ctx = ShadingContext::at(r.p);
-            let v = field.vertex(r.p).unwrap();
-            if let Some(s) = v.sample(&ctx, r.u) {
+            let v = field.vertex(&ShadingContext::at(r.p)).unwrap();
+            if let Some(s) = v.light.sample(&ctx, r.u) {
                 let LightId::Emitter(e) = s.light else {
                     continue;
                 };
                 let value = contribution(lights, e, r.p) / s.pmf;
-                v.splat_light(s.light, value, &mut rng.0);
+                v.light.record_light(s.light, value);
             }
-            if let Some(s) = glt.sample(&ctx, r.u) {
+            if let Some(s) = ByPosition(&glt).sample(&ctx, r.u) {
                 let LightId::Emitter(e) = s.light else {
                     continue;
                 };
-                glt.splat(
-                    r.p,
-                    s.light,
-                    contribution(lights, e, r.p) / s.pmf,
-                    &mut rng.0,
-                );
+                glt.record_light_at(r.p, s.light, contribution(lights, e, r.p) / s.pmf);
             }
-            v.splat_radiance(r.dir, r.radiance, UNIFORM_PDF, &mut rng.0);
-            sd.splat(r.p, r.dir, r.radiance, UNIFORM_PDF, &mut rng.0);
+            v.direction.record_radiance(r.dir, r.radiance, UNIFORM_PDF);
+            sd.record_radiance_at(r.p, r.dir, r.radiance, UNIFORM_PDF);
         }
         field.refine();
         sd.refine();
@@ -172,38 +167,37 @@ fn bench_field(c: &mut Criterion) {
     };
     let mut group = c.benchmark_group("field");
     group.bench_function("vertex", |b| {
-        b.iter(|| field.vertex(black_box(queries[next()].0.position)))
+        b.iter(|| field.vertex(&ShadingContext::at(black_box(queries[next()].0.position))))
     });
     // One path vertex's queries: the lookup, a guided direction, a light.
     group.bench_function("vertex+direction+light", |b| {
         b.iter(|| {
             let (ctx, u) = black_box(&queries[next()]);
-            let v = field.vertex(ctx.position).unwrap();
-            let d = v.sample_direction([u[0], u[1]]);
-            (d, v.sample(ctx, u[2]))
+            let v = field.vertex(ctx).unwrap();
+            let d = v.direction.sample_direction([u[0], u[1]]);
+            (d, v.light.sample(ctx, u[2]))
         })
     });
     // The same with a separate SD-tree and GLT: two lookups.
     group.bench_function("separate-sd+glt/direction+light", |b| {
         b.iter(|| {
             let (ctx, u) = black_box(&queries[next()]);
-            let d = sd.sample(ctx.position, [u[0], u[1]]);
-            (d, glt.sample(ctx, u[2]))
+            let d = sd.sample_direction_at(ctx.position, [u[0], u[1]]);
+            (d, ByPosition(&glt).sample(ctx, u[2]))
         })
     });
     // The whole vertex: queries and both records (both through the
     // stochastic box, as configured).
-    let mut rng = Pcg64Mcg::seed_from_u64(4);
     group.bench_function("vertex+direction+light+splats", |b| {
         b.iter(|| {
             let (ctx, u) = black_box(&queries[next()]);
-            let v = field.vertex(ctx.position).unwrap();
-            let (dir, pdf) = v.sample_direction([u[0], u[1]]);
-            let outcome = match v.sample(ctx, u[2]) {
-                Some(s) => v.splat_light(s.light, 0.5 / s.pmf, &mut rng),
-                None => SplatOutcome::Dropped,
+            let v = field.vertex(ctx).unwrap();
+            let (dir, pdf) = v.direction.sample_direction([u[0], u[1]]);
+            let outcome = match v.light.sample(ctx, u[2]) {
+                Some(s) => v.light.record_light(s.light, 0.5 / s.pmf),
+                None => RecordOutcome::Dropped,
             };
-            (v.splat_radiance(dir, 1.0, pdf, &mut rng), outcome)
+            (v.direction.record_radiance(dir, 1.0, pdf), outcome)
         })
     });
     group.finish();

@@ -27,6 +27,7 @@ use std::hint::black_box;
 #[path = "../tests/common/mod.rs"]
 mod common;
 use common::Rand;
+use common::{ByPosition, LightsAt};
 
 const LIGHTS: [usize; 5] = [100, 1_000, 10_000, 100_000, 1_000_000];
 const SIGMAS: [f64; 3] = [0.05, 0.01, 0.002];
@@ -272,8 +273,10 @@ fn bench_sampling(c: &mut Criterion) {
                 b.iter(|| {
                     let i = next();
                     let ctx = ShadingContext::on_surface(points[i], Vec3::Y);
-                    let s = glt.sample(black_box(&ctx), black_box(u[i])).unwrap();
-                    glt.pmf(&ctx, s.light)
+                    let s = ByPosition(&glt)
+                        .sample(black_box(&ctx), black_box(u[i]))
+                        .unwrap();
+                    ByPosition(&glt).pmf(&ctx, s.light)
                 })
             });
             group.bench_function("power/sample+pmf-moving", |b| {
@@ -284,15 +287,13 @@ fn bench_sampling(c: &mut Criterion) {
                     power.pmf(&ctx, s.light)
                 })
             });
-            let mut splat_rng = Rand::new(4);
             group.bench_function("glt/splat", |b| {
                 b.iter(|| {
                     let i = next();
-                    glt.splat(
+                    glt.record_light_at(
                         black_box(points[i]),
                         LightId::Emitter(i as u32 % n as u32),
                         black_box(1.5),
-                        &mut splat_rng.0,
                     )
                 })
             });
@@ -362,13 +363,13 @@ fn trained_glt<'a>(lights: &[Emitter], tree: &'a LightTree) -> Glt<&'a LightTree
                 rng.range(-90.0, 90.0),
             );
             let ctx = ShadingContext::on_surface(p, Vec3::Y);
-            let Some(s) = glt.sample(&ctx, rng.f()) else {
+            let Some(s) = ByPosition(&glt).sample(&ctx, rng.f()) else {
                 continue;
             };
             let LightId::Emitter(e) = s.light else {
                 continue;
             };
-            glt.splat(p, s.light, contribution(lights, e, p) / s.pmf, &mut rng.0);
+            glt.record_light_at(p, s.light, contribution(lights, e, p) / s.pmf);
         }
         glt.refine();
     }

@@ -2,6 +2,9 @@
 //! `sample`, `pdf`, `splat` (per filter and accumulation mode), and `refine`
 //! per cell. Prints the memory report and bytes per node.
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+use common::DirectionsAt;
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
 use guiding::math::{Aabb, Accumulation, canonical_to_dir};
@@ -45,7 +48,7 @@ fn trained(config: SdTreeConfig) -> SdTree {
     for k in 0..5 {
         for _ in 0..(20_000usize << k) {
             let (p, d) = (point(&mut rng), lobe_dir(&mut rng));
-            t.splat(p, d, 1.0, UNIFORM_PDF, &mut rng);
+            t.record_radiance_at(p, d, 1.0, UNIFORM_PDF);
         }
         t.refine();
     }
@@ -106,13 +109,13 @@ fn queries(c: &mut Criterion) {
     g.bench_function("sample", |b| {
         b.iter(|| {
             i = (i + 1) % QUERIES;
-            black_box(t.sample(black_box(points[i]), black_box(us[i])))
+            black_box(t.sample_direction_at(black_box(points[i]), black_box(us[i])))
         })
     });
     g.bench_function("pdf", |b| {
         b.iter(|| {
             i = (i + 1) % QUERIES;
-            black_box(t.pdf(black_box(points[i]), black_box(dirs[i])))
+            black_box(t.direction_pdf_at(black_box(points[i]), black_box(dirs[i])))
         })
     });
     let filters = [
@@ -128,20 +131,16 @@ fn queries(c: &mut Criterion) {
         ),
         ("splat/box+box", SpatialFilter::Box, DirectionalFilter::Box),
     ];
-    for (name, spatial, directional) in filters {
-        let mut r = Pcg32::seed_from_u64(3);
+    for (name, spatial_filter, directional_filter) in filters {
+        let filtered = trained(SdTreeConfig {
+            spatial_filter,
+            directional_filter,
+            ..config
+        });
         g.bench_function(name, |b| {
             b.iter(|| {
                 i = (i + 1) % QUERIES;
-                black_box(t.splat_filtered(
-                    points[i],
-                    dirs[i],
-                    1.0,
-                    0.5,
-                    spatial,
-                    directional,
-                    &mut r,
-                ))
+                black_box(filtered.record_radiance_at(points[i], dirs[i], 1.0, 0.5))
             })
         });
     }
@@ -150,11 +149,10 @@ fn queries(c: &mut Criterion) {
         ..config
     });
     report("deterministic", &det);
-    let mut r = Pcg32::seed_from_u64(3);
     g.bench_function("splat/nearest/deterministic", |b| {
         b.iter(|| {
             i = (i + 1) % QUERIES;
-            black_box(det.splat(points[i], dirs[i], 1.0, 0.5, &mut r))
+            black_box(det.record_radiance_at(points[i], dirs[i], 1.0, 0.5))
         })
     });
     g.finish();
@@ -171,8 +169,8 @@ fn refine(c: &mut Criterion) {
     let mut rng = Pcg32::seed_from_u64(4);
     for _ in 0..200_000 {
         let (p, d) = (point(&mut rng), lobe_dir(&mut rng));
-        t.splat(p, d, 1.0, UNIFORM_PDF, &mut rng);
-        t.record_fraction(p, unit(&mut rng), unit(&mut rng), unit(&mut rng));
+        t.record_radiance_at(p, d, 1.0, UNIFORM_PDF);
+        t.record_fraction_at(p, unit(&mut rng), unit(&mut rng), unit(&mut rng));
     }
     let cells = t.cell_count() as u64;
     println!("refine: {cells} cells before refining (time per cell = median / cells)");

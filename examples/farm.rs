@@ -134,7 +134,7 @@ fn render_passes(
     train: bool,
 ) -> PassStats {
     let guides = Guides {
-        lights: field,
+        lights: None,
         glt: None,
         sd_tree: None,
         field: Some(field),

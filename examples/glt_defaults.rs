@@ -97,20 +97,22 @@ fn main() {
                     for _ in 0..train << iteration.min(2) {
                         let p = Vec3::new(rs.f() * 40.0 - 20.0, 0.0, rs.f() * 40.0 - 20.0);
                         let ctx = ShadingContext::on_surface(p, Vec3::Y);
-                        let Some(s) = glt.sample(&ctx, rs.f()) else {
+                        let vertex = glt.vertex(&ctx).expect("a finite point");
+                        let Some(s) = vertex.sample(&ctx, rs.f()) else {
                             continue;
                         };
                         let LightId::Emitter(e) = s.light else {
                             continue;
                         };
                         let v = f(e as usize, p) as f32 / s.pmf;
-                        glt.splat(p, s.light, v, &mut rs.0);
+                        vertex.record_light(s.light, v);
                     }
                     glt.refine();
                 }
                 let (mut variance, mut square, mut missed) = (0.0f64, 0.0f64, 0.0f64);
                 for &p in &points {
                     let ctx = ShadingContext::on_surface(p, Vec3::Y);
+                    let vertex = glt.vertex(&ctx).expect("a finite point");
                     let (mut m2, mut total) = (0.0, 0.0);
                     for e in 0..lights.len() {
                         let fe = f(e, p);
@@ -118,7 +120,7 @@ fn main() {
                             continue;
                         }
                         total += fe;
-                        let pe = glt.pmf_exact(&ctx, LightId::Emitter(e as u32));
+                        let pe = vertex.pmf_exact(&ctx, LightId::Emitter(e as u32));
                         if pe > 0.0 {
                             m2 += fe * fe / pe;
                         } else {

@@ -1,5 +1,5 @@
-//! Counting the bad input that splats and fraction records drop: one
-//! [`DroppedSplats`] report for the SD-tree, the GLT and the field.
+//! Counting the bad input that records drop: one [`DroppedRecords`]
+//! report for the SD-tree, the GLT and the field.
 
 #[cfg(not(target_has_atomic = "64"))]
 use core::sync::atomic::AtomicU32 as AtomicCount;
@@ -7,10 +7,11 @@ use core::sync::atomic::AtomicU32 as AtomicCount;
 use core::sync::atomic::AtomicU64 as AtomicCount;
 use core::sync::atomic::Ordering::Relaxed;
 
-/// Why a splat or fraction record was dropped.
+/// Why a record was dropped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) enum DropReason {
-    /// The position has a NaN or infinite coordinate.
+    /// A vertex was asked for at a position with a NaN or infinite
+    /// coordinate (nothing can be recorded there).
     Position,
     /// The direction is NaN, infinite or of zero length.
     Direction,
@@ -22,7 +23,7 @@ pub(crate) enum DropReason {
     Pdf,
     /// `radiance / pdf` overflowed `f32`.
     Overflow,
-    /// A light splat: a non-finite position, a negative or non-finite
+    /// A light record: a negative or non-finite
     /// value, an emitter out of range or without power, or an unbounded
     /// light beyond the configured count.
     Light,
@@ -30,11 +31,12 @@ pub(crate) enum DropReason {
 
 const REASONS: usize = 6;
 
-/// Snapshot of how many splats and fraction records were dropped, per
-/// reason. Dropped input is never stored.
+/// Snapshot of how many records were dropped, per reason. Dropped input
+/// is never stored.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub struct DroppedSplats {
-    /// Non-finite positions.
+pub struct DroppedRecords {
+    /// Vertices asked for at non-finite positions (`vertex` returned
+    /// `None`: nothing can be recorded there).
     pub position: u64,
     /// NaN, infinite or zero-length directions.
     pub direction: u64,
@@ -44,14 +46,14 @@ pub struct DroppedSplats {
     pub pdf: u64,
     /// `radiance / pdf` not representable in `f32`.
     pub overflow: u64,
-    /// Light splats (of the GLT or the field's cuts), every reason
-    /// together: a non-finite position, a negative or non-finite value, an
+    /// Light and visibility records (of the GLT or the field's cuts), every
+    /// reason together: a negative or non-finite value, an
     /// emitter out of range or without power, or an unbounded light beyond
     /// the configured count.
     pub light: u64,
 }
 
-impl DroppedSplats {
+impl DroppedRecords {
     /// All dropped inputs.
     pub fn total(&self) -> u64 {
         self.position + self.direction + self.radiance + self.pdf + self.overflow + self.light
@@ -71,11 +73,11 @@ impl DropCounters {
         self.counts[reason as usize].fetch_add(1, Relaxed);
     }
 
-    pub(crate) fn snapshot(&self) -> DroppedSplats {
+    pub(crate) fn snapshot(&self) -> DroppedRecords {
         // A no-op cast where the counters are 64-bit, a widening elsewhere.
         #[allow(clippy::unnecessary_cast)]
         let get = |r: DropReason| self.counts[r as usize].load(Relaxed) as u64;
-        DroppedSplats {
+        DroppedRecords {
             position: get(DropReason::Position),
             direction: get(DropReason::Direction),
             radiance: get(DropReason::Radiance),

@@ -23,9 +23,12 @@
 //! 10. [`persist`]: saving, loading and merging what was learned.
 //!
 //! Each of [`sd_tree::SdTree`], [`glt::Glt`] and [`field::GuidingField`]
-//! locates a path vertex once with `vertex(p)` and answers and records
-//! through the handle; each owns (or shares, or borrows) its light tree;
-//! constructors validate their configuration ([`Error`]).
+//! locates a path vertex once with `vertex(&ctx)` and answers and records
+//! through what it gives: a [`DirectionVertex`] (the SD-tree's), a
+//! [`LightVertex`] (the GLT's) or both ([`FieldVertex`]), the same two
+//! types for every structure, so an integrator is written once; every
+//! record answers a [`RecordOutcome`]. Each owns (or shares, or borrows)
+//! its light tree; constructors validate their configuration ([`Error`]).
 //!
 //! ## Where things are
 //!
@@ -54,7 +57,7 @@
 //!   [`shared_guide::SharedGuide`]). [`math::Accumulation::Deterministic`]
 //!   makes learned state bit-identical whatever the thread count.
 //! - Bad input never panics: builds return typed errors, records drop and
-//!   count it ([`DroppedSplats`]); invalid configuration is an error, never
+//!   count it ([`DroppedRecords`]); invalid configuration is an error, never
 //!   a silent clamp.
 //!
 //! ## What a renderer passes and records
@@ -67,8 +70,8 @@
 //! | a light's power ([`Emitter::power`], [`Emitters::power`]) | its flux, one scalar (the luminance of an RGB power, or any fixed positive weighting), the same unit for every kind: a point light of intensity `I`, `4 pi I`; a spot light of peak intensity `I`, `4 pi I` too (pbrt-v4's convention: a point light as bright, its cone bounds where it shines; [`Emitter::spot`]); a one-sided Lambertian area light of radiance `L` and area `A`, `pi L A` (two-sided: `2 pi L A`); a sphere of radius `r`, `4 pi^2 r^2 L`; textured emission: the integral of `pi L` over the surface (per side) |
 //! | sun, sky and other lights with no position | not emitters: [`UnboundedLights`] with their number and the probability they share; `0.25` shared is what the render example uses beside many lights (for the GLT it is only the prior's share and the defensive floor, each cell learns its own); pbrt-v4's fixed choice uses `count / (count + 1)` |
 //! | which normal ([`ShadingContext::on_surface`]) | the shading normal, the one in the cosine of the estimate; its sign does not matter; none ([`ShadingContext::at`]) in media |
-//! | what a light sample records ([`glt::Glt::splat`], a vertex's `splat_light`) | `luminance(Le) * factor` with the [`mis::DirectLight`] factor of its convention: the light's arriving radiance, not times the BSDF and cosine, MIS-weighted and divided by the pdf; [`mis::DirectLight::estimate`] gives the contribution and the record from one call, for pbrt-v4's or pbrt-v3's convention ([`mis::Convention`]) |
-//! | a jitter source for a vertex's `splat_light` | only the stochastic filters draw from it; with the default nearest filter nothing is drawn, and a renderer with no generator at hand passes `&mut spatial::JitterNumbers([0.0; 3])` |
+//! | what a light sample records ([`LightVertex::record_light`]) | `luminance(Le) * factor` with the [`mis::DirectLight`] factor of its convention: the light's arriving radiance, not times the BSDF and cosine, MIS-weighted and divided by the pdf; [`mis::DirectLight::estimate`] gives the contribution and the record from one call, for pbrt-v4's or pbrt-v3's convention ([`mis::Convention`]) |
+//! | random numbers for a record | none: the stochastic box filter (off by default for light records) takes its offset from a hash of the record (`src/spatial/jitter.rs`), so the same records learn the same state on any thread count |
 //! | an occluded sample, a light behind the surface, a BSDF that is zero (and the shadow ray skipped) | record 0 or nothing, never a shadow ray for the record's sake: a zero adds nothing to what is learned; it only counts as a sample for the split and refinement rules, which then follow where paths go rather than where light arrives ([`schedule`]) |
 //! | when to call `refine` | after each of PPG's doubling iterations ([`schedule::Iterations`]); a renderer that renders each tile to completion, after every wave of tiles (as many as it has threads): a GLT cell refines once it holds 3/2 of its records before ([`glt::GltCell`], [`schedule`]) |
 //! | the spatial threshold | [`glt::GltConfig::default`]'s, measured for renderers (docs/experiments/tile-order.md) |
@@ -96,6 +99,7 @@ pub mod mis;
 pub mod path_recorder;
 pub mod persist;
 pub mod quadtree;
+mod record;
 pub mod resampling;
 pub mod schedule;
 pub mod sd_tree;
@@ -112,9 +116,11 @@ pub use glam;
 /// its generator in this one's trait.
 pub use rand_core;
 
-pub use dropped::DroppedSplats;
+pub use dropped::DroppedRecords;
 pub use emitter::{Emitter, Emitters, ShadingContext};
 pub use error::{ConfigError, Error};
+pub use field::FieldVertex;
+pub use glt::LightVertex;
 pub use light_sampler::{
     ImportanceTreeSampler, LightId, LightSample, LightSampler, PowerSampler, PowerTreeSampler,
     UnboundedLights, UniformSampler, WithUnbounded,
@@ -122,4 +128,6 @@ pub use light_sampler::{
 pub use light_tree::{LightHierarchy, LightTree};
 pub use path_recorder::PathRecorder;
 pub use persist::LoadError;
+pub use record::RecordOutcome;
+pub use sd_tree::DirectionVertex;
 pub use strategy::Strategy;

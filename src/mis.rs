@@ -38,7 +38,7 @@ pub fn balance_heuristic(a: f32, b: f32) -> f32 {
 
 /// How a renderer combines its light sample with its BSDF sample. Both are
 /// unbiased; they differ in which BSDF samples compete with which light,
-/// and so in the MIS weights, the contributions and the light splats.
+/// and so in the MIS weights, the contributions and the light records.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Convention {
     /// pbrt-v4 (and the render example): one light sample per vertex from
@@ -62,8 +62,9 @@ pub enum Convention {
 ///   `f_cos * le * factor` (`f_cos` the BSDF value times the cosine; for a
 ///   BSDF sample whose `f_cos / pdf` the path throughput already holds,
 ///   that is `le * weight` added through the throughput);
-/// - value to record for the light ([`crate::glt::Glt::splat`],
-///   `splat_light` of a field vertex): `luminance(le) * factor` (or any
+/// - value to record for the light
+///   ([`LightVertex::record_light`](crate::LightVertex::record_light)):
+///   `luminance(le) * factor` (or any
 ///   fixed scalar of `le`), whatever its visibility: an occluded sample
 ///   records 0 (see the `schedule` module's rule on zero-valued records).
 ///
@@ -88,7 +89,7 @@ pub struct DirectEstimate {
     /// Added to the path's radiance at the vertex (before the path's
     /// throughput): `f_cos * le * factor`, 0 when occluded.
     pub contribution: Vec3,
-    /// The value to record for the light (`splat` / `splat_light`):
+    /// The value to record for the light (`record_light`):
     /// `luminance(le) * factor`, 0 when occluded (record it, or record
     /// nothing: the schedule module's rule on zero-valued records).
     pub record: f32,

@@ -10,10 +10,10 @@
 //! loop {
 //!     hit emitter   -> recorder.add_radiance(Le * w_bsdf)          // MIS-weighted
 //!     NEE at vertex -> recorder.add_radiance(f cos Le * w_light / p)
-//!     scatter       -> recorder.push_segment(cell, x, wi, pdf, bsdf_pdf, guide_pdf, f cos / pdf)
+//!     scatter       -> recorder.push_segment(vertex, wi, pdf, bsdf_pdf, guide_pdf, f cos / pdf)
 //!     specular      -> recorder.scatter_unrecorded(f cos / pdf)
 //! }
-//! recorder.finish(&guide, &mut rng);   // the SD-tree's (or the field's) records
+//! recorder.finish();   // each vertex's radiance and fraction records
 //! let pixel = recorder.estimate();
 //! ```
 //!
@@ -24,14 +24,11 @@
 //! between them), without dividing by the path throughput: a colour channel
 //! that the throughput zeroes loses nothing of the others.
 //!
-//! Light splats (the GLT's records) do not wait for the end of the path:
-//! the renderer makes them where it finds direct light, with
-//! [`crate::glt::Glt::splat`] or a field vertex.
+//! Light records (the GLT's) do not wait for the end of the path: the
+//! renderer makes them where it finds direct light, through the vertex's
+//! [`LightVertex::record_light`](crate::LightVertex::record_light).
 
-use crate::field::{FieldVertex, GuidingField};
-use crate::light_tree::LightHierarchy;
-use crate::sd_tree::SdTree;
-use crate::spatial::Jitter;
+use crate::sd_tree::DirectionVertex;
 use alloc::vec::Vec;
 use glam::Vec3;
 
@@ -45,13 +42,12 @@ pub fn luminance(c: Vec3) -> f32 {
 /// One scattering of a path: where it left from, in which direction, with
 /// which pdfs and throughput factor, and (after [`PathRecorder::finish`])
 /// the radiance that arrived back along it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Segment<C> {
-    /// What the renderer located at this vertex (a field vertex, or `()`
-    /// for an SD-tree, which locates the cell again when recording).
-    pub cell: C,
-    /// The vertex the path left from.
-    pub position: Vec3,
+#[derive(Clone, Copy, Debug)]
+pub struct Segment<'a> {
+    /// The directional guiding of the vertex the path left from, which
+    /// [`PathRecorder::finish`] records into; `None` for a vertex nothing
+    /// learns at.
+    pub vertex: Option<DirectionVertex<'a>>,
     /// The direction it left in (unit).
     pub direction: Vec3,
     /// The solid-angle pdf the direction was sampled with (the mixture of
@@ -66,7 +62,7 @@ pub struct Segment<C> {
     /// MIS-weighted radiance found at the end of this segment (the
     /// emitter it hit, and what next-event estimation found there).
     pub found: Vec3,
-    /// The radiance that arrived at `position` along `direction`, filled
+    /// The radiance that arrived at the vertex along `direction`, filled
     /// by [`PathRecorder::finish`].
     pub incident: Vec3,
     /// The throughput of the unrecorded (specular) scatterings after this
@@ -74,88 +70,22 @@ pub struct Segment<C> {
     factor: Vec3,
 }
 
-impl<C> Segment<C> {
-    /// The same segment with another `cell` (to route it to a structure
-    /// that located it differently).
-    pub fn with_cell<D>(&self, cell: D) -> Segment<D> {
-        Segment {
-            cell,
-            position: self.position,
-            direction: self.direction,
-            pdf: self.pdf,
-            bsdf_pdf: self.bsdf_pdf,
-            guide_pdf: self.guide_pdf,
-            weight: self.weight,
-            found: self.found,
-            incident: self.incident,
-            factor: self.factor,
-        }
-    }
-}
-
-/// Where a recorder's segments go at the end of a path: the SD-tree's
-/// radiance splat and BSDF-fraction record, or the field's through the
-/// vertex the renderer located. Implement it for a renderer's own
-/// structure to route records elsewhere.
-pub trait RadianceRecords<C> {
-    /// Records one finished segment. `radiance` is
-    /// `luminance(segment.incident)`, `contribution` is
-    /// `luminance(segment.weight * segment.incident)` (what the learned
-    /// BSDF fraction optimises).
-    fn record<J: Jitter + ?Sized>(
-        &self,
-        segment: &Segment<C>,
-        radiance: f32,
-        contribution: f32,
-        jitter: &mut J,
-    );
-}
-
-impl RadianceRecords<()> for SdTree {
-    #[inline]
-    fn record<J: Jitter + ?Sized>(
-        &self,
-        s: &Segment<()>,
-        radiance: f32,
-        contribution: f32,
-        jitter: &mut J,
-    ) {
-        self.splat(s.position, s.direction, radiance, s.pdf, jitter);
-        self.record_fraction(s.position, s.bsdf_pdf, s.guide_pdf, contribution);
-    }
-}
-
-impl<'f, H: LightHierarchy> RadianceRecords<FieldVertex<'f, H>> for GuidingField<H> {
-    #[inline]
-    fn record<J: Jitter + ?Sized>(
-        &self,
-        s: &Segment<FieldVertex<'f, H>>,
-        radiance: f32,
-        contribution: f32,
-        jitter: &mut J,
-    ) {
-        s.cell.splat_radiance(s.direction, radiance, s.pdf, jitter);
-        s.cell
-            .record_fraction(s.bsdf_pdf, s.guide_pdf, contribution);
-    }
-}
-
 /// The bookkeeping of one path at a time (reuse it between paths: its
 /// storage is kept). See the [module docs](self).
 #[derive(Clone, Debug)]
-pub struct PathRecorder<C = ()> {
-    segments: Vec<Segment<C>>,
+pub struct PathRecorder<'a> {
+    segments: Vec<Segment<'a>>,
     throughput: Vec3,
     estimate: Vec3,
 }
 
-impl<C> Default for PathRecorder<C> {
+impl Default for PathRecorder<'_> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<C> PathRecorder<C> {
+impl<'a> PathRecorder<'a> {
     /// An empty recorder.
     pub fn new() -> Self {
         Self {
@@ -193,16 +123,14 @@ impl<C> PathRecorder<C> {
         }
     }
 
-    /// The path leaves `position` along `direction`, sampled with the
+    /// The path leaves `vertex` along `direction`, sampled with the
     /// mixture pdf `pdf` (BSDF pdf `bsdf_pdf`, guide pdf `guide_pdf`), with
-    /// throughput factor `weight = f cos / pdf`. `cell` is what the
-    /// renderer located there, handed back when the segment is recorded.
-    #[allow(clippy::too_many_arguments)]
+    /// throughput factor `weight = f cos / pdf`. `vertex` is the
+    /// directional guiding located there (`None`: nothing learns there).
     #[inline]
     pub fn push_segment(
         &mut self,
-        cell: C,
-        position: Vec3,
+        vertex: Option<DirectionVertex<'a>>,
         direction: Vec3,
         pdf: f32,
         bsdf_pdf: f32,
@@ -211,8 +139,7 @@ impl<C> PathRecorder<C> {
     ) {
         self.throughput *= weight;
         self.segments.push(Segment {
-            cell,
-            position,
+            vertex,
             direction,
             pdf,
             bsdf_pdf,
@@ -244,17 +171,19 @@ impl<C> PathRecorder<C> {
 
     /// The recorded segments (their `incident` radiance is filled by
     /// [`PathRecorder::finish`]).
-    pub fn segments(&self) -> &[Segment<C>] {
+    pub fn segments(&self) -> &[Segment<'a>] {
         &self.segments
     }
 
-    /// Computes the radiance that arrived along every segment and hands
-    /// each one with a finite, non-negative value to `records`.
-    pub fn finish<S: RadianceRecords<C> + ?Sized, J: Jitter + ?Sized>(
-        &mut self,
-        records: &S,
-        jitter: &mut J,
-    ) {
+    /// Computes the radiance that arrived along every segment and, for
+    /// each one with a vertex and a finite value, makes that vertex's two
+    /// records: [`DirectionVertex::record_radiance`] of
+    /// `luminance(incident)` along the segment's direction with its pdf,
+    /// and [`DirectionVertex::record_fraction`] with its two pdfs and
+    /// `luminance(weight * incident)` (what the learned BSDF fraction
+    /// optimises). The segments keep their `incident` radiance for a
+    /// renderer that routes records elsewhere.
+    pub fn finish(&mut self) {
         // L_i = found_i + factor_i w_(i+1) L_(i+1), from the last segment.
         let mut after = Vec3::ZERO;
         let mut next_weight = Vec3::ZERO;
@@ -264,9 +193,11 @@ impl<C> PathRecorder<C> {
             next_weight = s.weight;
         }
         for s in &self.segments {
-            if s.incident.is_finite() {
-                let radiance = luminance(s.incident);
-                records.record(s, radiance, luminance(s.weight * s.incident), jitter);
+            if let Some(v) = &s.vertex
+                && s.incident.is_finite()
+            {
+                v.record_radiance(s.direction, luminance(s.incident), s.pdf);
+                v.record_fraction(s.bsdf_pdf, s.guide_pdf, luminance(s.weight * s.incident));
             }
         }
     }

@@ -68,9 +68,10 @@ impl<H: LightHierarchy> Refine for GuidingField<H> {
 ///         s.spawn(move || {
 ///             for tile in 0..8 {
 ///                 let glt = guide.read(); // one tile
-///                 let p = Vec3::new(0.1 * t as f32, 0.0, 0.1);
-///                 let x = glt.sample(&ShadingContext::at(p), 0.5).unwrap();
-///                 glt.splat_at(p, x.light, 1.0 / x.pmf);
+///                 let ctx = ShadingContext::at(Vec3::new(0.1 * t as f32, 0.0, 0.1));
+///                 let v = glt.vertex(&ctx).unwrap();
+///                 let x = v.sample(&ctx, 0.5).unwrap();
+///                 v.record_light(x.light, 1.0 / x.pmf);
 ///                 drop(glt);
 ///                 if tile == 3 && t == 0 {
 ///                     guide.refine(); // mid-render, from a worker

@@ -14,7 +14,7 @@ use crate::math::Aabb;
 /// A light-selection strategy by name: `"uniform"`, `"power"`,
 /// `"importance"` (the light BVH of Estevez-Kulla and pbrt-v4) or `"glt"`
 /// (the Guiding Light Tree, with its training side through
-/// [`Strategy::glt_mut`]). It owns its light tree, is `Send + Sync`, and
+/// [`Strategy::glt`] and [`Strategy::glt_mut`]). It owns its light tree, is `Send + Sync`, and
 /// samples exactly as the sampler it wraps, the scene's unbounded lights
 /// (distant, infinite) beside the emitters.
 ///
@@ -86,8 +86,19 @@ impl Strategy {
         }
     }
 
-    /// The GLT, for its training side (splats, refine); `None` for the
-    /// strategies that do not learn.
+    /// The GLT, to record through its vertices
+    /// ([`Glt::vertex`](crate::glt::Glt::vertex)); `None` for the
+    /// strategies that do not learn. As a [`LightSampler`] the strategy
+    /// looks the GLT's cell up on every query; a renderer that records
+    /// locates the vertex once here and samples through it.
+    pub fn glt(&self) -> Option<&Glt<LightTree>> {
+        match self {
+            Self::Glt(g) => Some(g),
+            _ => None,
+        }
+    }
+
+    /// The GLT, to refine it; `None` for the strategies that do not learn.
     pub fn glt_mut(&mut self) -> Option<&mut Glt<LightTree>> {
         match self {
             Self::Glt(g) => Some(&mut **g),
@@ -99,12 +110,17 @@ impl Strategy {
 /// Calls `$call` on the sampler inside (a `match`, not a virtual call: this
 /// runs per sample).
 macro_rules! inner {
-    ($self:ident, $s:ident => $call:expr) => {
+    ($self:ident, $ctx:expr, $s:ident => $call:expr, $none:expr) => {
         match $self {
             Strategy::Uniform($s) => $call,
             Strategy::Power($s) => $call,
             Strategy::Importance($s) => $call,
-            Strategy::Glt($s) => $call,
+            // By position: one lookup per call (a renderer that also
+            // records locates the vertex once, through `Strategy::glt`).
+            Strategy::Glt(g) => match g.vertex_uncounted($ctx.position) {
+                Some($s) => $call,
+                None => $none,
+            },
         }
     };
 }
@@ -112,33 +128,38 @@ macro_rules! inner {
 impl LightSampler for Strategy {
     #[inline]
     fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
-        inner!(self, s => s.sample(ctx, u))
+        inner!(self, ctx, s => s.sample(ctx, u), None)
     }
 
     #[inline]
     fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        inner!(self, s => s.pmf(ctx, light))
+        inner!(self, ctx, s => s.pmf(ctx, light), 0.0)
     }
 
     fn is_empty(&self) -> bool {
-        inner!(self, s => s.is_empty())
+        match self {
+            Strategy::Uniform(s) => s.is_empty(),
+            Strategy::Power(s) => s.is_empty(),
+            Strategy::Importance(s) => s.is_empty(),
+            Strategy::Glt(g) => g.cut_rules().is_empty(),
+        }
     }
 
     #[inline]
     fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
-        inner!(self, s => s.sample_exact(ctx, u))
+        inner!(self, ctx, s => s.sample_exact(ctx, u), None)
     }
 
     #[inline]
     fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
-        inner!(self, s => s.pmf_exact(ctx, light))
+        inner!(self, ctx, s => s.pmf_exact(ctx, light), 0.0)
     }
 
     fn visibility(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        inner!(self, s => s.visibility(ctx, light))
+        inner!(self, ctx, s => s.visibility(ctx, light), 1.0)
     }
 
     fn sample_with_visibility(&self, ctx: &ShadingContext, u: f32) -> Option<(LightSample, f32)> {
-        inner!(self, s => s.sample_with_visibility(ctx, u))
+        inner!(self, ctx, s => s.sample_with_visibility(ctx, u), None)
     }
 }

@@ -4,6 +4,7 @@
 //! sample with another region's learned choice.
 
 mod common;
+use common::{ByPosition, LightsAt};
 
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
@@ -52,13 +53,13 @@ fn train_left_half<H: LightHierarchy>(
 ) {
     for _ in 0..n {
         let p = room_point(rng, true);
-        let Some(s) = glt.sample(&ShadingContext::at(p), rng.f()) else {
+        let Some(s) = ByPosition(&*glt).sample(&ShadingContext::at(p), rng.f()) else {
             continue;
         };
         let LightId::Emitter(e) = s.light else {
             continue;
         };
-        glt.splat_at(p, s.light, value(lights, e, p) / s.pmf);
+        glt.record_light_at(p, s.light, value(lights, e, p) / s.pmf);
     }
     glt.refine();
 }
@@ -80,14 +81,14 @@ fn the_half_not_rendered_yet_keeps_the_prior_choice() {
     let (mut better, mut n) = (0, 0);
     for k in 0..64 {
         let (left, right) = (room_point(&mut rng, true), room_point(&mut rng, false));
-        let learned = sampler_variance(&glt, &lights, right);
-        let untrained = sampler_variance(&prior, &lights, right);
+        let learned = sampler_variance(&ByPosition(&glt), &lights, right);
+        let untrained = sampler_variance(&ByPosition(&prior), &lights, right);
         assert!(
             learned <= untrained * (1.0 + 1e-6),
             "at {right} (not rendered yet): variance {learned} against the prior's {untrained} (point {k})"
         );
-        let learned_left = sampler_variance(&glt, &lights, left);
-        better += usize::from(learned_left < sampler_variance(&prior, &lights, left));
+        let learned_left = sampler_variance(&ByPosition(&glt), &lights, left);
+        better += usize::from(learned_left < sampler_variance(&ByPosition(&prior), &lights, left));
         n += 1;
     }
     assert!(

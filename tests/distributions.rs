@@ -13,6 +13,7 @@
 //! returns ([`Swapped`]).
 
 mod common;
+use common::{ByPosition, DirectionsAt, LightsAt};
 
 use common::{Rand, Z_P_1E4, chi_square_z, scene, two_rooms, value};
 use glam::Vec3;
@@ -20,7 +21,6 @@ use guiding::field::{FieldConfig, GuidingField};
 use guiding::glt::{CutConfig, Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::sd_tree::SdTreeConfig;
-use guiding::spatial::JitterNumbers;
 use guiding::{
     LightId, LightSample, LightSampler, LightTree, ShadingContext, Strategy, UnboundedLights,
 };
@@ -217,23 +217,28 @@ fn found(p: Vec3, light: LightId) -> f32 {
 
 /// `iterations` of NEE training: at random points, a light drawn from
 /// `sample`, its estimate splatted through `splat`, then `refine`.
-fn train<S: LightSampler>(
-    sampler: &mut S,
+/// Trains `guide` by light samples drawn from it, each recorded through
+/// the vertex that drew it, with `also` recording more at the point.
+fn train<G: LightsAt>(
+    guide: &mut G,
     iterations: usize,
-    splat: impl Fn(&S, Vec3, LightId, f32, &mut Rand),
-    refine: impl Fn(&mut S),
+    also: impl Fn(&G, Vec3, f32, &mut Rand),
+    refine: impl Fn(&mut G),
 ) {
     let mut rng = Rand::new(5);
     for _ in 0..iterations {
         for _ in 0..8000 {
             let p = rng.point(9.5);
             let ctx = ShadingContext::at(p);
-            let Some(x) = sampler.sample(&ctx, rng.f()) else {
+            let v = guide.light_at(p);
+            let Some(x) = v.sample(&ctx, rng.f()) else {
                 continue;
             };
-            splat(sampler, p, x.light, found(p, x.light) / x.pmf, &mut rng);
+            let value = found(p, x.light) / x.pmf;
+            v.record_light(x.light, value);
+            also(guide, p, value, &mut rng);
         }
-        refine(sampler);
+        refine(guide);
     }
 }
 
@@ -254,9 +259,7 @@ fn glt(paper: bool, unbounded: UnboundedLights, iterations: usize) -> Glt<&'stat
     train(
         &mut g,
         iterations,
-        |g, p, l, v, _| {
-            g.splat_at(p, l, v);
-        },
+        |_, _, _, _| {},
         |g| {
             g.refine();
         },
@@ -275,11 +278,8 @@ fn field(unbounded: UnboundedLights, iterations: usize) -> GuidingField<&'static
     train(
         &mut f,
         iterations,
-        |f, p, l, v, rng| {
-            let v_ = f.vertex(p).unwrap();
-            let mut j = JitterNumbers([rng.f(), rng.f(), rng.f()]);
-            v_.splat_light(l, v, &mut j);
-            v_.splat_radiance(rng.dir(), v + 0.1, 0.25, &mut j);
+        |f, p, v, rng| {
+            f.record_radiance_at(p, rng.dir(), v + 0.1, 0.25);
         },
         |f| {
             f.refine();
@@ -298,7 +298,7 @@ fn glt_draws_from_its_pmf() {
                     assert!(g.memory().cells > 1, "the GLT learned cells");
                 }
                 let what = format!("GLT paper={paper} unbounded={k} trained={iterations}");
-                check(&what, &g, k, 100);
+                check(&what, &ByPosition(&g), k, 100);
             }
         }
     }
@@ -310,7 +310,7 @@ fn glt_draws_from_its_pmf() {
 fn glt_vertex_draws_from_its_pmf() {
     let g = glt(false, sun_and_sky(), 4);
     for ctx in contexts() {
-        let v = g.vertex(ctx.position).unwrap();
+        let v = g.vertex(&ShadingContext::at(ctx.position)).unwrap();
         check("GLT vertex", &v, 2, 200);
     }
 }
@@ -325,7 +325,7 @@ fn field_draws_from_its_pmf() {
             }
             check(
                 &format!("field unbounded={k} trained={iterations}"),
-                &f,
+                &ByPosition(&f),
                 k,
                 300,
             );
@@ -333,8 +333,8 @@ fn field_draws_from_its_pmf() {
     }
     let f = field(sun_and_sky(), 4);
     for ctx in contexts() {
-        let v = f.vertex(ctx.position).unwrap();
-        check("field vertex", &v, 2, 400);
+        let v = f.vertex(&ShadingContext::at(ctx.position)).unwrap();
+        check("field vertex", &v.light, 2, 400);
     }
 }
 
@@ -356,9 +356,7 @@ fn strategy_draws_from_its_pmf() {
             train(
                 g,
                 3,
-                |g, p, l, v, _| {
-                    g.splat_at(p, l, v);
-                },
+                |_, _, _, _| {},
                 |g| {
                     g.refine();
                 },

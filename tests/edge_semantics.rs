@@ -4,6 +4,7 @@
 //! exact (`f64`) variants agree bit for bit.
 
 mod common;
+use common::{ByPosition, LightsAt};
 
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
@@ -92,17 +93,23 @@ fn every_sampler_has_the_same_edges() {
     for _ in 0..3 {
         for _ in 0..3000 {
             let p = rng.point(9.5);
-            let s = glt.sample(&ShadingContext::at(p), rng.f()).unwrap();
+            let s = ByPosition(&glt)
+                .sample(&ShadingContext::at(p), rng.f())
+                .unwrap();
             if let LightId::Emitter(e) = s.light {
-                glt.splat(p, s.light, value(&lights, e, p) / s.pmf, &mut rng.0);
+                glt.record_light_at(p, s.light, value(&lights, e, p) / s.pmf);
             }
         }
         glt.refine();
     }
-    check("glt", &glt, n);
+    check("glt", &ByPosition(&glt), n);
     let guide = CutRules::new(&tree, CutConfig::default()).unwrap();
     let cut = guide.new_cut();
-    check("cut sampler", &guide.sampler(&cut), n);
+    check(
+        "cut sampler",
+        &guide.vertex(&cut, &ShadingContext::at(Vec3::ZERO)),
+        n,
+    );
     let field = GuidingField::new(&tree, scene(), FieldConfig::default()).unwrap();
-    check("field", &field, n);
+    check("field", &ByPosition(&field), n);
 }

@@ -9,6 +9,7 @@
 //! the wall between the two rooms (the field too).
 
 mod common;
+use common::{ByPosition, LightsAt};
 
 use common::{Rand, two_rooms, value};
 use glam::Vec3;
@@ -129,7 +130,7 @@ fn trained_glt(lights: &[Emitter], tree: &LightTree, d: Vec3) -> Glt<LightTree> 
         for _ in 0..(3000 << round) {
             let p = rng.point(9.5);
             let e = rng.below(80);
-            glt.splat_at(p + d, LightId::Emitter(e), value(lights, e, p));
+            glt.record_light_at(p + d, LightId::Emitter(e), value(lights, e, p));
         }
         glt.refine();
     }
@@ -156,7 +157,7 @@ fn glt_far_away() {
         let far_lights = shifted(&lights, d);
         let tree = LightTree::build(&far_lights, BuildHeuristic::Sarh).unwrap();
         let far = trained_glt(&lights, &tree, d);
-        let (mean, worst) = variation(&near, &far, d, &pts);
+        let (mean, worst) = variation(&ByPosition(&near), &ByPosition(&far), d, &pts);
         println!(
             "GLT at {o:e}: {} cells (centred {}), total variation mean {mean:.2e}, worst {worst:.2e}",
             far.memory().cells,
@@ -170,14 +171,18 @@ fn glt_far_away() {
         }
         assert!(mean <= tolerance(o), "offset {o}: {mean}");
         for &(p, n) in &pts[..20] {
-            assert_contract(&far, &ShadingContext::on_surface(p + d, n), &mut rng);
+            assert_contract(
+                &ByPosition(&far),
+                &ShadingContext::on_surface(p + d, n),
+                &mut rng,
+            );
         }
         // The wall is learned at every offset.
         let left = Vec3::new(-5.0, 0.0, 0.0);
         assert!(
-            right_room(&far, left + d) < 0.3,
+            right_room(&ByPosition(&far), left + d) < 0.3,
             "offset {o}: {}",
-            right_room(&far, left + d)
+            right_room(&ByPosition(&far), left + d)
         );
     }
 }
@@ -196,23 +201,25 @@ fn field_far_away() {
         for _ in 0..3 {
             for _ in 0..6000 {
                 let p = records.point(9.5);
-                let v = field.vertex(p + d).unwrap();
+                let v = field.vertex(&ShadingContext::at(p + d)).unwrap();
                 let e = records.below(80);
-                v.splat_light(LightId::Emitter(e), value(&lights, e, p), &mut records.0);
+                v.light
+                    .record_light(LightId::Emitter(e), value(&lights, e, p));
                 let dir = records.dir();
-                v.splat_radiance(dir, 1.0 + 20.0 * dir.y.max(0.0), 0.3, &mut records.0);
+                v.direction
+                    .record_radiance(dir, 1.0 + 20.0 * dir.y.max(0.0), 0.3);
             }
             field.refine();
         }
         for (p, n) in points(8).into_iter().take(30) {
             let ctx = ShadingContext::on_surface(p + d, n);
-            assert_contract(&field, &ctx, &mut rng);
-            let v = field.vertex(p + d).unwrap();
-            let (dir, pdf) = v.sample_direction([rng.f(), rng.f()]);
+            assert_contract(&ByPosition(&field), &ctx, &mut rng);
+            let v = field.vertex(&ShadingContext::at(p + d)).unwrap();
+            let (dir, pdf) = v.direction.sample_direction([rng.f(), rng.f()]);
             assert!(pdf > 0.0 && pdf.is_finite() && dir.is_finite());
         }
         let left = Vec3::new(-5.0, 0.0, 0.0) + d;
-        assert!(right_room(&field, left) < 0.3, "offset {o}");
+        assert!(right_room(&ByPosition(&field), left) < 0.3, "offset {o}");
         println!("field at {o:e}: {} cells", field.cell_count());
     }
 }

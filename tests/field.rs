@@ -4,8 +4,9 @@
 //! input counted, threads equal a serial run, and the memory report.
 
 use glam::Vec3;
+use guiding::RecordOutcome;
 use guiding::field::{FieldConfig, GuidingField};
-use guiding::glt::{BelowCut, CutConfig, CutRules, Glt, GltConfig, GuidingCut, SplatOutcome};
+use guiding::glt::{BelowCut, CutConfig, CutRules, Glt, GltConfig, GuidingCut};
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::{Aabb, Accumulation, canonical_to_dir};
 use guiding::quadtree::UNIFORM_PDF;
@@ -17,9 +18,9 @@ use guiding::{
 };
 use proptest::prelude::*;
 use rand_pcg::Pcg32;
-use rand_pcg::rand_core::{Rng, SeedableRng};
 
 mod common;
+use common::{ByPosition, DirectionsAt, LightsAt};
 use common::{scene, two_rooms_with, value};
 
 /// The shared generator over `Pcg32`: these tests were tuned on its streams.
@@ -126,38 +127,50 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
                 p => p,
             };
             let ctx = ShadingContext::at(p);
-            let v = field.vertex(p).unwrap();
+            let v = field.vertex(&ShadingContext::at(p)).unwrap();
             let cut = &cuts[sd.spatial().locate(p).unwrap().index()];
             // NEE: the vertex's cut and the reference cut agree.
             let u = rng.f();
-            let s = v.sample(&ctx, u).unwrap();
+            let s = v.light.sample(&ctx, u).unwrap();
             assert_eq!(Some(s), guide.sample(cut, &ctx, u));
             assert_eq!(s.pmf.to_bits(), guide.pmf(cut, &ctx, s.light).to_bits());
             let val = value(&lights, emitter(s.light), p) / s.pmf;
             assert_eq!(
-                v.splat_light(s.light, val, &mut rng.0),
+                v.light.record_light(s.light, val),
                 guide.splat_from(cut, p, s.light, val)
             );
             // Directions: sample, pdf, fraction, mixture.
             let u = [rng.f(), rng.f()];
-            let (dir, pdf) = v.sample_direction(u);
-            assert_eq!(Some((dir, pdf)), sd.sample(p, u));
-            assert_eq!(v.direction_pdf(dir).to_bits(), pdf.to_bits());
-            assert_eq!(v.bsdf_fraction().to_bits(), sd.bsdf_fraction(p).to_bits());
+            let (dir, pdf) = v.direction.sample_direction(u);
+            assert_eq!(Some((dir, pdf)), sd.sample_direction_at(p, u));
+            assert_eq!(v.direction.direction_pdf(dir).to_bits(), pdf.to_bits());
             assert_eq!(
-                v.mixture_pdf(dir, 0.3).to_bits(),
-                sd.mixture_pdf(p, dir, 0.3).to_bits()
+                v.direction.bsdf_fraction().to_bits(),
+                sd.bsdf_fraction_at(p).to_bits()
             );
-            learned |= v.bsdf_fraction() != 0.5;
-            // PPG's record with the stochastic box, same random numbers.
-            let seed = rng.0.next_u64();
+            assert_eq!(
+                v.direction.mixture_pdf(dir, 0.3).to_bits(),
+                sd.mixture_pdf_at(p, dir, 0.3).to_bits()
+            );
+            learned |= v.direction.bsdf_fraction() != 0.5;
+            // PPG's record with the stochastic box (its offset hashed from
+            // the record: the same for both).
             let d = light_dir(&lights, p, &mut rng);
             let radiance = rng.range(0.0, 4.0);
-            assert!(v.splat_radiance(d, radiance, UNIFORM_PDF, &mut Pcg32::seed_from_u64(seed)));
-            assert!(sd.splat(p, d, radiance, UNIFORM_PDF, &mut Pcg32::seed_from_u64(seed)));
+            assert_ne!(
+                v.direction.record_radiance(d, radiance, UNIFORM_PDF),
+                RecordOutcome::Dropped
+            );
+            assert_ne!(
+                sd.record_radiance_at(p, d, radiance, UNIFORM_PDF),
+                RecordOutcome::Dropped
+            );
             let (pb, pg, c) = (rng.f(), pdf, rng.range(0.0, 2.0));
-            assert!(v.record_fraction(pb, pg, c));
-            assert!(sd.record_fraction(p, pb, pg, c));
+            assert_ne!(
+                v.direction.record_fraction(pb, pg, c),
+                RecordOutcome::Dropped
+            );
+            assert_ne!(sd.record_fraction_at(p, pb, pg, c), RecordOutcome::Dropped);
         }
         // The reference's refinement: cuts first, then the SD-tree; a cell
         // born of a split takes its parent's (refined) cut.
@@ -200,17 +213,20 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
         let p = rng.point(11.0);
         let ctx = ShadingContext::at(p);
         let cut = &cuts[sd.spatial().locate(p).unwrap().index()];
-        let v = field.vertex(p).unwrap();
+        let v = field.vertex(&ShadingContext::at(p)).unwrap();
         for e in [0, 17, 39, 40, 79] {
             let l = LightId::Emitter(e);
             let x = guide.pmf_exact(cut, &ctx, l).to_bits();
-            assert_eq!(v.pmf_exact(&ctx, l).to_bits(), x);
-            assert_eq!(field.pmf_exact(&ctx, l).to_bits(), x);
+            assert_eq!(v.light.pmf_exact(&ctx, l).to_bits(), x);
+            assert_eq!(ByPosition(&field).pmf_exact(&ctx, l).to_bits(), x);
         }
         let u = rng.f64();
-        assert_eq!(v.sample_exact(&ctx, u), guide.sample_exact(cut, &ctx, u));
         assert_eq!(
-            field.sample_exact(&ctx, u),
+            v.light.sample_exact(&ctx, u),
+            guide.sample_exact(cut, &ctx, u)
+        );
+        assert_eq!(
+            ByPosition(&field).sample_exact(&ctx, u),
             guide.sample_exact(cut, &ctx, u)
         );
     }
@@ -219,11 +235,12 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
 /// The field against a [`Glt`] over its own spatial tree. The two split
 /// cells by different counts (the field by radiance-splat weight, halved
 /// exactly; the GLT by its number of light splats, halved as an integer),
-/// so their spatial decisions agree when every light splat comes with a
-/// radiance splat at the same point and counts stay multiples of 16 (no
+/// so their spatial decisions agree when every light record comes with a
+/// radiance record at the same point, both go to the cell holding it (the
+/// nearest filter: a jittered light record may land in a neighbour the
+/// radiance record does not reach) and counts stay multiples of 16 (no
 /// cascade here halves more than 3 times). Then cells, cuts, pmfs and
-/// samples are equal bit for bit, the GLT's jittered splat
-/// (`splat` / `splat_light`, same generator) included.
+/// samples are equal bit for bit.
 #[test]
 fn equals_a_glt_fed_the_same_light_splats() {
     let (lights, tree) = rooms();
@@ -238,13 +255,13 @@ fn equals_a_glt_fed_the_same_light_splats() {
             cut,
             spatial_threshold: 200.0,
             max_bytes: None,
-            filter: SpatialFilter::StochasticBox,
+            light_filter: SpatialFilter::Nearest,
         },
     )
     .unwrap();
     let config = FieldConfig {
         cut,
-        light_filter: SpatialFilter::StochasticBox,
+        light_filter: SpatialFilter::Nearest,
         ..config_with(200.0, SdTreeConfig::default())
     };
     let mut field = GuidingField::new(&tree, scene(), config).unwrap();
@@ -265,15 +282,21 @@ fn equals_a_glt_fed_the_same_light_splats() {
         for _ in 0..100 {
             let ctx = ShadingContext::at(rng.point(10.5));
             let u = rng.f();
-            assert_eq!(field.sample(&ctx, u), glt.sample(&ctx, u));
-            let v = field.vertex(ctx.position).unwrap();
-            assert_eq!(v.sample(&ctx, u), glt.sample(&ctx, u));
+            assert_eq!(
+                ByPosition(field).sample(&ctx, u),
+                ByPosition(glt).sample(&ctx, u)
+            );
+            let v = field.vertex(&ShadingContext::at(ctx.position)).unwrap();
+            assert_eq!(v.light.sample(&ctx, u), ByPosition(glt).sample(&ctx, u));
             for e in [3, 44, 71] {
                 let l = LightId::Emitter(e);
-                assert_eq!(field.pmf(&ctx, l).to_bits(), glt.pmf(&ctx, l).to_bits());
                 assert_eq!(
-                    v.pmf_exact(&ctx, l).to_bits(),
-                    glt.pmf_exact(&ctx, l).to_bits()
+                    ByPosition(field).pmf(&ctx, l).to_bits(),
+                    ByPosition(glt).pmf(&ctx, l).to_bits()
+                );
+                assert_eq!(
+                    v.light.pmf_exact(&ctx, l).to_bits(),
+                    ByPosition(glt).pmf_exact(&ctx, l).to_bits()
                 );
             }
         }
@@ -289,8 +312,11 @@ fn equals_a_glt_fed_the_same_light_splats() {
             let d = light_dir(&lights, p, &mut rng);
             for _ in 0..16 {
                 let l = LightId::Emitter(e);
-                assert_eq!(field.splat_light_at(p, l, v), glt.splat_at(p, l, v));
-                assert!(field.splat_radiance(p, d, 1.0, UNIFORM_PDF, &mut rng.0));
+                assert_eq!(field.record_light_at(p, l, v), glt.record_light_at(p, l, v));
+                assert_ne!(
+                    field.record_radiance_at(p, d, 1.0, UNIFORM_PDF),
+                    RecordOutcome::Dropped
+                );
             }
         }
         compare(&field, &glt, &mut rng);
@@ -299,19 +325,14 @@ fn equals_a_glt_fed_the_same_light_splats() {
         compare(&field, &glt, &mut rng);
     }
     assert!(field.cell_count() > 8, "{}", field.cell_count());
-    // The jittered record: the same generator gives the same cells. Few
-    // enough that no cell of the GLT reaches its split threshold.
-    let seed = rng.0.next_u64();
-    let (mut a, mut b) = (Pcg32::seed_from_u64(seed), Pcg32::seed_from_u64(seed));
+    // More records, fewer than any cell of the GLT needs to split: the
+    // cells stay, the cuts learn the same.
     for _ in 0..300 {
         let p = rng.point(9.8);
         let e = (rng.f() * 80.0) as u32;
         let v = value(&lights, e, p);
         let l = LightId::Emitter(e);
-        assert_eq!(
-            field.splat_light(p, l, v, &mut a),
-            glt.splat(p, l, v, &mut b)
-        );
+        assert_eq!(field.record_light_at(p, l, v), glt.record_light_at(p, l, v));
     }
     compare(&field, &glt, &mut rng);
     let cells = field.cell_count();
@@ -369,13 +390,13 @@ proptest! {
             for _ in 0..(200 + (rng.f() * 600.0) as usize) {
                 let p = rng.point(10.5);
                 let ctx = ShadingContext::at(p);
-                let v = field.vertex(p).unwrap();
-                if let Some(s) = v.sample(&ctx, rng.f()) {
+                let v = field.vertex(&ShadingContext::at(p)).unwrap();
+                if let Some(s) = v.light.sample(&ctx, rng.f()) {
                     let val = if rng.f() < 0.3 { 0.0 } else { rng.range(0.0, 3.0) / s.pmf };
-                    prop_assert_ne!(v.splat_light(s.light, val, &mut rng.0), SplatOutcome::Dropped);
+                    prop_assert_ne!(v.light.record_light(s.light, val), RecordOutcome::Dropped);
                 }
-                let (d, _) = v.sample_direction([rng.f(), rng.f()]);
-                prop_assert!(v.splat_radiance(d, rng.range(0.0, 2.0), 0.5, &mut rng.0));
+                let (d, _) = v.direction.sample_direction([rng.f(), rng.f()]);
+                prop_assert_ne!(v.direction.record_radiance(d, rng.range(0.0, 2.0), 0.5), RecordOutcome::Dropped);
             }
             field.refine();
         }
@@ -385,23 +406,23 @@ proptest! {
         for _ in 0..25 {
             let p = rng.point(11.0);
             let ctx = ShadingContext::on_surface(p, rng.point(1.0).normalize_or(Vec3::Z));
-            let v = field.vertex(p).unwrap();
+            let v = field.vertex(&ShadingContext::at(p)).unwrap();
             let mut total: f64 = (0..n as u32)
-                .map(|e| v.pmf_exact(&ctx, LightId::Emitter(e)))
+                .map(|e| v.light.pmf_exact(&ctx, LightId::Emitter(e)))
                 .sum();
-            total += (0..unbounded).map(|i| v.pmf_exact(&ctx, LightId::Unbounded(i))).sum::<f64>();
+            total += (0..unbounded).map(|i| v.light.pmf_exact(&ctx, LightId::Unbounded(i))).sum::<f64>();
             prop_assert!((total - 1.0).abs() < 1e-5, "pmf sums to {}", total);
             for _ in 0..20 {
                 let u = rng.f();
-                let s = v.sample(&ctx, u).unwrap();
-                prop_assert_eq!(Some(s), field.sample(&ctx, u));
-                prop_assert_eq!(s.pmf.to_bits(), v.pmf(&ctx, s.light).to_bits());
-                prop_assert_eq!(s.pmf.to_bits(), field.pmf(&ctx, s.light).to_bits());
-                let (l, q) = v.sample_exact(&ctx, rng.f64()).unwrap();
-                prop_assert_eq!(q.to_bits(), v.pmf_exact(&ctx, l).to_bits());
-                let (d, pdf) = v.sample_direction([rng.f(), rng.f()]);
+                let s = v.light.sample(&ctx, u).unwrap();
+                prop_assert_eq!(Some(s), ByPosition(&field).sample(&ctx, u));
+                prop_assert_eq!(s.pmf.to_bits(), v.light.pmf(&ctx, s.light).to_bits());
+                prop_assert_eq!(s.pmf.to_bits(), ByPosition(&field).pmf(&ctx, s.light).to_bits());
+                let (l, q) = v.light.sample_exact(&ctx, rng.f64()).unwrap();
+                prop_assert_eq!(q.to_bits(), v.light.pmf_exact(&ctx, l).to_bits());
+                let (d, pdf) = v.direction.sample_direction([rng.f(), rng.f()]);
                 prop_assert!(pdf > 0.0);
-                prop_assert_eq!(pdf.to_bits(), v.direction_pdf(d).to_bits());
+                prop_assert_eq!(pdf.to_bits(), v.direction.direction_pdf(d).to_bits());
             }
         }
     }
@@ -427,15 +448,15 @@ fn trained_field<'a>(
                 p if it == 0 => Vec3::new(-p.x.abs(), p.y, p.z),
                 p => p,
             };
-            let v = field.vertex(p).unwrap();
-            let s = v.sample(&ShadingContext::at(p), rng.f()).unwrap();
+            let v = field.vertex(&ShadingContext::at(p)).unwrap();
+            let s = v.light.sample(&ShadingContext::at(p), rng.f()).unwrap();
             let val = value(lights, emitter(s.light), p) / s.pmf;
-            assert_ne!(
-                v.splat_light(s.light, val, &mut rng.0),
-                SplatOutcome::Dropped
-            );
+            assert_ne!(v.light.record_light(s.light, val), RecordOutcome::Dropped);
             let d = light_dir(lights, p, &mut rng);
-            assert!(v.splat_radiance(d, 1.0, UNIFORM_PDF, &mut rng.0));
+            assert_ne!(
+                v.direction.record_radiance(d, 1.0, UNIFORM_PDF),
+                RecordOutcome::Dropped
+            );
         }
         let outcome = field.refine();
         after_refine(&field, outcome);
@@ -455,14 +476,14 @@ fn direction_pdf_integrates_to_one_in_every_cell() {
     let mut deep = 0;
     for c in field.spatial().cells() {
         let p = field.spatial().cell_bounds(c).center();
-        let v = field.vertex(p).unwrap();
-        assert_eq!(v.cell(), c);
-        let leaves = v.sd().directions().sampling_leaves();
+        let v = field.vertex(&ShadingContext::at(p)).unwrap();
+        assert_eq!(v.direction.cell(), c);
+        let leaves = v.direction.sd().directions().sampling_leaves();
         deep += (leaves.len() > 16) as usize;
         let integral: f64 = leaves
             .iter()
             .map(|l| {
-                v.direction_pdf(canonical_to_dir(l.center())) as f64
+                v.direction.direction_pdf(canonical_to_dir(l.center())) as f64
                     * l.area()
                     * 4.0
                     * core::f64::consts::PI
@@ -478,7 +499,7 @@ fn direction_pdf_integrates_to_one_in_every_cell() {
     let alpha = field.config().cut.alpha;
     let ctx = ShadingContext::at(Vec3::new(-8.0, 0.0, 0.0));
     let mass: f64 = (0..40)
-        .map(|e| field.pmf_exact(&ctx, LightId::Emitter(e)))
+        .map(|e| ByPosition(&field).pmf_exact(&ctx, LightId::Emitter(e)))
         .sum();
     assert!(mass > 1.0 - alpha * 0.5 - 0.02, "{mass}");
 }
@@ -494,18 +515,20 @@ fn spatial_split_copies_both_payloads() {
     let mut field = GuidingField::new(&tree, scene(), config).unwrap();
     let p = Vec3::new(-9.0, -9.0, -9.0);
     let dir = Vec3::new(0.2, 1.0, 0.1);
-    let mut rng = Rand::seeded(6);
-    let round = |field: &GuidingField<&LightTree>, rng: &mut Rand| {
-        let v = field.vertex(p).unwrap();
+    let round = |field: &GuidingField<&LightTree>| {
+        let v = field.vertex(&ShadingContext::at(p)).unwrap();
         for _ in 0..1000 {
-            assert!(v.splat_radiance(dir, 1.0, 1.0, &mut rng.0));
+            assert_ne!(
+                v.direction.record_radiance(dir, 1.0, 1.0),
+                RecordOutcome::Dropped
+            );
             assert_eq!(
-                field.splat_light_at(p, LightId::Emitter(3), 2.0),
-                SplatOutcome::Recorded
+                field.record_light_at(p, LightId::Emitter(3), 2.0),
+                RecordOutcome::Recorded
             );
         }
     };
-    round(&field, &mut rng);
+    round(&field);
     // 1000 -> 500 -> 250 -> 125 -> 62.5 against 100: four levels, everywhere.
     let out = field.refine();
     assert_eq!(out.splits, 15);
@@ -524,40 +547,66 @@ fn spatial_split_copies_both_payloads() {
     }
     let far = Vec3::new(9.0, 9.0, 9.0);
     let near_ctx = ShadingContext::at(p);
-    let (vn, vf) = (field.vertex(p).unwrap(), field.vertex(far).unwrap());
-    assert_ne!(vn.cell(), vf.cell());
+    let (vn, vf) = (
+        field.vertex(&ShadingContext::at(p)).unwrap(),
+        field.vertex(&ShadingContext::at(far)).unwrap(),
+    );
+    assert_ne!(vn.direction.cell(), vf.direction.cell());
     // One refinement from the uniform tree: the root level learned (about 4x).
-    assert!(vn.direction_pdf(dir) > 3.0 * UNIFORM_PDF);
+    assert!(vn.direction.direction_pdf(dir) > 3.0 * UNIFORM_PDF);
     assert_eq!(
-        vn.direction_pdf(dir).to_bits(),
-        vf.direction_pdf(dir).to_bits()
+        vn.direction.direction_pdf(dir).to_bits(),
+        vf.direction.direction_pdf(dir).to_bits()
     );
     // The same learned cut in both cells, but the far cell got none of the
     // light splats it learned from: there it samples as the prior does,
     // near p as learned.
-    assert_eq!(vn.cut().confidence(), 1.0);
-    assert_eq!(vf.cut().confidence(), 0.0);
+    assert_eq!(vn.light.cut().confidence(), 1.0);
+    assert_eq!(vf.light.cut().confidence(), 0.0);
     let l3 = LightId::Emitter(3);
     let prior = GuidingField::new(&tree, scene(), config).unwrap();
-    let untrained = prior.vertex(p).unwrap().pmf_exact(&near_ctx, l3);
-    assert_eq!(vf.pmf_exact(&near_ctx, l3).to_bits(), untrained.to_bits());
-    let learned = vn.pmf_exact(&near_ctx, l3);
+    let untrained = prior
+        .vertex(&ShadingContext::at(p))
+        .unwrap()
+        .light
+        .pmf_exact(&near_ctx, l3);
+    assert_eq!(
+        vf.light.pmf_exact(&near_ctx, l3).to_bits(),
+        untrained.to_bits()
+    );
+    let learned = vn.light.pmf_exact(&near_ctx, l3);
     assert!(learned > 1.2 * untrained, "{learned} against {untrained}");
     // A second round near p, another direction and light: only that cell
     // learns it; the far one keeps its copies.
     let dir2 = Vec3::new(1.0, -0.3, 0.0);
-    let v = field.vertex(p).unwrap();
+    let v = field.vertex(&ShadingContext::at(p)).unwrap();
     for _ in 0..200 {
-        assert!(v.splat_radiance(dir2, 1.0, 1.0, &mut rng.0));
-        v.splat_light(LightId::Emitter(30), 5.0, &mut rng.0);
+        assert_ne!(
+            v.direction.record_radiance(dir2, 1.0, 1.0),
+            RecordOutcome::Dropped
+        );
+        v.light.record_light(LightId::Emitter(30), 5.0);
     }
-    let far_pdf = field.vertex(far).unwrap().direction_pdf(dir2);
+    let far_pdf = field
+        .vertex(&ShadingContext::at(far))
+        .unwrap()
+        .direction
+        .direction_pdf(dir2);
     field.refine();
-    let (vn, vf) = (field.vertex(p).unwrap(), field.vertex(far).unwrap());
-    assert!(vn.direction_pdf(dir2) > 10.0 * vf.direction_pdf(dir2));
-    assert_eq!(vf.direction_pdf(dir2).to_bits(), far_pdf.to_bits());
-    assert_eq!(vf.pmf_exact(&near_ctx, l3).to_bits(), untrained.to_bits());
-    assert!(vn.pmf_exact(&near_ctx, LightId::Emitter(30)) > 0.5);
+    let (vn, vf) = (
+        field.vertex(&ShadingContext::at(p)).unwrap(),
+        field.vertex(&ShadingContext::at(far)).unwrap(),
+    );
+    assert!(vn.direction.direction_pdf(dir2) > 10.0 * vf.direction.direction_pdf(dir2));
+    assert_eq!(
+        vf.direction.direction_pdf(dir2).to_bits(),
+        far_pdf.to_bits()
+    );
+    assert_eq!(
+        vf.light.pmf_exact(&near_ctx, l3).to_bits(),
+        untrained.to_bits()
+    );
+    assert!(vn.light.pmf_exact(&near_ctx, LightId::Emitter(30)) > 0.5);
 }
 
 /// Bad input is dropped, counted per kind and never stored, through the
@@ -575,10 +624,9 @@ fn bad_input_is_dropped_and_counted() {
         ..FieldConfig::default()
     };
     let mut field = GuidingField::new(&tree, scene(), config).unwrap();
-    let mut rng = Rand::seeded(5);
     let p = Vec3::ONE;
     let nan = Vec3::new(f32::NAN, 0.0, 0.0);
-    let v = field.vertex(p).unwrap();
+    let v = field.vertex(&ShadingContext::at(p)).unwrap();
     // Radiance splats: position, direction, radiance, pdf, overflow.
     let bad = [
         (nan, Vec3::Z, 1.0, 1.0),
@@ -592,12 +640,12 @@ fn bad_input_is_dropped_and_counted() {
         (p, Vec3::Z, 1.0e30, 1.0e-30),
     ];
     for &(q, d, r, pdf) in &bad {
-        assert!(!field.splat_radiance(q, d, r, pdf, &mut rng.0));
+        assert!((field.record_radiance_at(q, d, r, pdf) == RecordOutcome::Dropped));
         if q == p {
-            assert!(!v.splat_radiance(d, r, pdf, &mut rng.0));
+            assert!((v.direction.record_radiance(d, r, pdf) == RecordOutcome::Dropped));
         }
     }
-    let dropped = field.dropped_splats();
+    let dropped = field.dropped_records();
     assert_eq!(
         (
             dropped.position,
@@ -609,11 +657,11 @@ fn bad_input_is_dropped_and_counted() {
         (2, 4, 4, 4, 2)
     );
     // Fraction records.
-    assert!(!field.record_fraction(nan, 1.0, 1.0, 1.0));
-    assert!(!v.record_fraction(1.0, 1.0, f32::NAN));
-    assert!(!v.record_fraction(-1.0, 1.0, 1.0));
-    assert!(!v.record_fraction(0.0, 0.0, 1.0));
-    assert_eq!(field.dropped_splats().total(), 16 + 4);
+    assert!((field.record_fraction_at(nan, 1.0, 1.0, 1.0) == RecordOutcome::Dropped));
+    assert!((v.direction.record_fraction(1.0, 1.0, f32::NAN) == RecordOutcome::Dropped));
+    assert!((v.direction.record_fraction(-1.0, 1.0, 1.0) == RecordOutcome::Dropped));
+    assert!((v.direction.record_fraction(0.0, 0.0, 1.0) == RecordOutcome::Dropped));
+    assert_eq!(field.dropped_records().total(), 16 + 4);
     // Light splats: values, positions, emitters out of range or dark, the
     // environment without one.
     let lbad = [
@@ -626,43 +674,45 @@ fn bad_input_is_dropped_and_counted() {
         (p, LightId::Unbounded(0), 1.0),
     ];
     for (i, &(q, l, x)) in lbad.iter().enumerate() {
-        assert_eq!(
-            field.splat_light(q, l, x, &mut rng.0),
-            SplatOutcome::Dropped
-        );
-        assert_eq!(field.splat_light_at(q, l, x), SplatOutcome::Dropped);
+        assert_eq!(field.record_light_at(q, l, x), RecordOutcome::Dropped);
+        assert_eq!(field.record_light_at(q, l, x), RecordOutcome::Dropped);
         if q == p {
-            assert_eq!(v.splat_light(l, x, &mut rng.0), SplatOutcome::Dropped);
+            assert_eq!(v.light.record_light(l, x), RecordOutcome::Dropped);
         }
-        assert!(field.dropped_splats().light >= 2 * (i as u64 + 1));
+        assert!(field.dropped_records().light >= 2 * (i as u64 + 1));
     }
-    assert_eq!(field.dropped_splats().light, 2 * 7 + 6);
+    // The records at a non-finite point find no vertex: two positions.
+    assert_eq!(field.dropped_records().light, 2 * 6 + 6);
+    assert_eq!(field.dropped_records().position, 2 + 1 + 2);
     // Nothing was stored.
     let cell = field.spatial().data_slice()[0].clone();
     assert_eq!(cell.sd().building_weight(), 0.0);
     assert_eq!(cell.sd().directions().building_total(), 0.0);
     assert_eq!(cell.cut().accumulated(), (0.0, 0.0));
     // Valid zeros are valid.
-    assert!(v.splat_radiance(Vec3::Z, 0.0, 1.0, &mut rng.0));
+    assert_ne!(
+        v.direction.record_radiance(Vec3::Z, 0.0, 1.0),
+        RecordOutcome::Dropped
+    );
     assert_eq!(
-        v.splat_light(LightId::Emitter(1), 0.0, &mut rng.0),
-        SplatOutcome::Zero
+        v.light.record_light(LightId::Emitter(1), 0.0),
+        RecordOutcome::Zero
     );
     // One report: 20 radiance and fraction records, 20 light splats.
-    assert_eq!(field.dropped_splats().total(), 20 + 20);
+    assert_eq!(field.dropped_records().total(), 20 + 20);
     // Queries at non-finite points.
-    assert!(field.vertex(nan).is_none());
+    assert!(field.vertex(&ShadingContext::at(nan)).is_none());
     let ctx = ShadingContext::at(nan);
-    assert!(field.sample(&ctx, 0.5).is_none());
-    assert_eq!(field.pmf(&ctx, LightId::Emitter(0)), 0.0);
-    assert_eq!(field.pmf_exact(&ctx, LightId::Emitter(0)), 0.0);
-    assert!(field.sample_exact(&ctx, 0.5).is_none());
+    assert!(ByPosition(&field).sample(&ctx, 0.5).is_none());
+    assert_eq!(ByPosition(&field).pmf(&ctx, LightId::Emitter(0)), 0.0);
+    assert_eq!(ByPosition(&field).pmf_exact(&ctx, LightId::Emitter(0)), 0.0);
+    assert!(ByPosition(&field).sample_exact(&ctx, 0.5).is_none());
     // A refinement with nothing valid learned changes nothing.
     field.refine();
     assert_eq!(field.cell_count(), 1);
-    field.reset_dropped_splats();
-    assert_eq!(field.dropped_splats().total(), 0);
-    assert_eq!(field.dropped_splats().light, 0);
+    field.reset_dropped_records();
+    assert_eq!(field.dropped_records().total(), 0);
+    assert_eq!(field.dropped_records().light, 0);
 }
 
 struct Input {
@@ -671,13 +721,12 @@ struct Input {
     radiance: f32,
     light: (u32, f32),
     fraction: (f32, f32, f32),
-    seed: u64,
 }
 
 fn inputs(lights: &[Emitter], n: usize, seed: u64) -> Vec<Input> {
     let mut rng = Rand::seeded(seed);
     (0..n)
-        .map(|i| {
+        .map(|_| {
             let p = rng.point(9.8);
             let e = (rng.f() * 80.0) as u32;
             Input {
@@ -688,23 +737,28 @@ fn inputs(lights: &[Emitter], n: usize, seed: u64) -> Vec<Input> {
                 radiance: rng.range(0.0, 3.0) * rng.range(-25.0, 25.0).exp2(),
                 light: (e, value(lights, e, p) * rng.range(-25.0, 25.0).exp2()),
                 fraction: (rng.range(0.0, 2.0), rng.range(0.0, 2.0), rng.f()),
-                seed: i as u64 ^ seed << 32,
             }
         })
         .collect()
 }
 
 fn apply(field: &GuidingField<&LightTree>, input: &Input) {
-    let mut rng = Pcg32::seed_from_u64(input.seed);
-    let v = field.vertex(input.p).unwrap();
-    assert!(v.splat_radiance(input.dir, input.radiance, UNIFORM_PDF, &mut rng));
+    let v = field.vertex(&ShadingContext::at(input.p)).unwrap();
+    assert_ne!(
+        v.direction
+            .record_radiance(input.dir, input.radiance, UNIFORM_PDF),
+        RecordOutcome::Dropped
+    );
     let (e, x) = input.light;
     assert_ne!(
-        v.splat_light(LightId::Emitter(e), x, &mut rng),
-        SplatOutcome::Dropped
+        v.light.record_light(LightId::Emitter(e), x),
+        RecordOutcome::Dropped
     );
     let (pb, pg, c) = input.fraction;
-    assert!(v.record_fraction(pb, pg, c));
+    assert_ne!(
+        v.direction.record_fraction(pb, pg, c),
+        RecordOutcome::Dropped
+    );
 }
 
 /// Feeds a batch from `threads` threads (0: the calling thread, in reverse
@@ -797,7 +851,10 @@ fn memory_report_adds_up_and_compares_cuts_with_quadtrees() {
             };
             rng.f(); // the number the field's light sample took
             let d = light_dir(&lights, p, &mut rng);
-            assert!(sd.splat(p, d, 1.0, UNIFORM_PDF, &mut rng.0));
+            assert_ne!(
+                sd.record_radiance_at(p, d, 1.0, UNIFORM_PDF),
+                RecordOutcome::Dropped
+            );
         }
         sd.refine();
     }

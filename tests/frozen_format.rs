@@ -21,6 +21,7 @@
 //! versions' files are never rewritten.
 
 mod common;
+use common::{ByPosition, LightsAt};
 
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
@@ -31,7 +32,7 @@ use guiding::math::Accumulation;
 use guiding::persist::FORMAT_VERSION;
 use guiding::quadtree::DirectionalFilter;
 use guiding::sd_tree::{SdTree, SdTreeConfig};
-use guiding::spatial::{JitterNumbers, SpatialFilter};
+use guiding::spatial::SpatialFilter;
 use guiding::{
     ImportanceTreeSampler, LightId, LightSampler, LightTree, LoadError, ShadingContext,
     UnboundedLights,
@@ -69,7 +70,7 @@ fn glt_configured() -> GltConfig {
         },
         spatial_threshold: 300.0,
         max_bytes: Some(1 << 20),
-        filter: SpatialFilter::StochasticBox,
+        light_filter: SpatialFilter::StochasticBox,
     }
 }
 
@@ -146,15 +147,10 @@ fn trained_glt(config: GltConfig) -> Glt<&'static LightTree> {
     let k = config.cut.unbounded.count + 80;
     train(
         &mut g,
-        |g, p, e, v, rng| {
+        |g, p, e, v, _| {
             if e < k {
-                g.splat(
-                    p,
-                    light(e),
-                    v,
-                    &mut JitterNumbers([rng.f(), rng.f(), rng.f()]),
-                );
-                g.splat_visibility(p, light(e), 0.5 * v, v);
+                g.record_light_at(p, light(e), v);
+                g.record_visibility_at(p, light(e), 0.5 * v, v);
             }
         },
         |g| {
@@ -169,10 +165,9 @@ fn trained_sd(config: SdTreeConfig) -> SdTree {
     train(
         &mut t,
         |t, p, _, v, rng| {
-            let x = t.vertex(p).unwrap();
+            let x = t.vertex(&ShadingContext::at(p)).unwrap();
             let d = rng.dir();
-            let mut j = JitterNumbers([rng.f(), rng.f(), rng.f()]);
-            x.splat_radiance(d, v + 5.0 * d.y.max(0.0), 0.3, &mut j);
+            x.record_radiance(d, v + 5.0 * d.y.max(0.0), 0.3);
             x.record_fraction(0.2 + rng.f(), 0.1 + rng.f(), v);
         },
         |t| {
@@ -188,15 +183,14 @@ fn trained_field(config: FieldConfig) -> GuidingField<&'static LightTree> {
     train(
         &mut f,
         |f, p, e, v, rng| {
-            let x = f.vertex(p).unwrap();
+            let x = f.vertex(&ShadingContext::at(p)).unwrap();
             let d = rng.dir();
-            let mut j = JitterNumbers([rng.f(), rng.f(), rng.f()]);
             if e < k {
-                x.splat_light(light(e), v, &mut j);
-                x.splat_visibility(light(e), 0.5 * v, v);
+                x.light.record_light(light(e), v);
+                x.light.record_visibility(light(e), 0.5 * v, v);
             }
-            x.splat_radiance(d, v + 5.0 * d.y.max(0.0), 0.3, &mut j);
-            x.record_fraction(0.2 + rng.f(), 0.1 + rng.f(), v);
+            x.direction.record_radiance(d, v + 5.0 * d.y.max(0.0), 0.3);
+            x.direction.record_fraction(0.2 + rng.f(), 0.1 + rng.f(), v);
         },
         |f| {
             f.refine();
@@ -306,7 +300,7 @@ fn load_and_answer(
             want.cut = learned(want.cut);
             assert_eq!(*g.config(), want, "{name}: configuration");
             assert_eq!(g.iteration(), 3);
-            light_answers(&g, &mut out);
+            light_answers(&ByPosition(&g), &mut out);
             g.to_bytes()
         }
         "sd_tree_default" | "sd_tree_configured" => {
@@ -319,7 +313,7 @@ fn load_and_answer(
             assert_eq!(*t.config(), want, "{name}: configuration");
             direction_answers(
                 |p, d| {
-                    let v = t.vertex(p).unwrap();
+                    let v = t.vertex(&ShadingContext::at(p)).unwrap();
                     v.direction_pdf(d) + 1000.0 * v.bsdf_fraction()
                 },
                 &mut out,
@@ -338,11 +332,11 @@ fn load_and_answer(
             };
             want.cut = learned(want.cut);
             assert_eq!(f.config(), want, "{name}: configuration");
-            light_answers(&f, &mut out);
+            light_answers(&ByPosition(&f), &mut out);
             direction_answers(
                 |p, d| {
-                    let v = f.vertex(p).unwrap();
-                    v.direction_pdf(d) + 1000.0 * v.bsdf_fraction()
+                    let v = f.vertex(&ShadingContext::at(p)).unwrap();
+                    v.direction.direction_pdf(d) + 1000.0 * v.direction.bsdf_fraction()
                 },
                 &mut out,
             );

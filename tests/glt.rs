@@ -6,8 +6,7 @@
 
 use glam::Vec3;
 use guiding::glt::{
-    BelowCut, CutConfig, CutNode, CutRules, GuidingCut, Modulation, Prior, Slot, SplatOutcome,
-    SplitPrior,
+    BelowCut, CutConfig, CutNode, CutRules, GuidingCut, Modulation, Prior, Slot, SplitPrior,
 };
 use guiding::light_tree::{BuildHeuristic, EmitterPath, NodeBounds};
 use guiding::math::{Aabb, Accumulation, LightCone, Side};
@@ -17,7 +16,9 @@ use guiding::{
 use proptest::prelude::*;
 
 mod common;
+use common::LightsAt;
 use common::Rand;
+use guiding::RecordOutcome;
 
 // ---------------------------------------------------------------------------
 // Helpers
@@ -104,7 +105,7 @@ fn assert_sample_matches_pmf<H: LightHierarchy + ?Sized>(
     rng: &mut Rand,
     draws: usize,
 ) {
-    let sampler = guide.sampler(cut);
+    let sampler = guide.vertex(cut, &ShadingContext::at(Vec3::ZERO));
     for _ in 0..draws {
         let u = rng.f64();
         if let Some((light, p)) = guide.sample_exact(cut, ctx, u) {
@@ -317,11 +318,11 @@ proptest! {
                     LightId::Unbounded(i) => i >= config.unbounded.count,
                 };
                 if value.is_bad() || dark {
-                    prop_assert_eq!(outcome, SplatOutcome::Dropped);
+                    prop_assert_eq!(outcome, RecordOutcome::Dropped);
                 } else if value.get() == 0.0 {
-                    prop_assert_eq!(outcome, SplatOutcome::Zero);
+                    prop_assert_eq!(outcome, RecordOutcome::Zero);
                 } else {
-                    prop_assert_eq!(outcome, SplatOutcome::Recorded);
+                    prop_assert_eq!(outcome, RecordOutcome::Recorded);
                 }
             }
             guide.refine(&mut cut);
@@ -485,7 +486,7 @@ fn too_few_splats_defer_the_rebuild_and_keep_the_data() {
     for e in 0..300 {
         assert_eq!(
             guide.splat(&cut, LightId::Emitter(e), 0.0),
-            SplatOutcome::Zero
+            RecordOutcome::Zero
         );
     }
     assert!(!guide.refine(&mut cut));
@@ -965,7 +966,7 @@ fn zero_power_subtrees() {
         for _ in 0..3 {
             for e in 0..200u32 {
                 let o = guide.splat(&cut, LightId::Emitter(e), 1.0);
-                assert_eq!(o == SplatOutcome::Dropped, e < 100);
+                assert_eq!(o == RecordOutcome::Dropped, e < 100);
             }
             guide.refine(&mut cut);
             assert_valid_cut(&tree, &cut);
@@ -1367,7 +1368,7 @@ fn a_cut_as_a_light_sampler_answers_as_its_rules() {
         guide.splat_visibility(&cut, LightId::Emitter(e), 0.25, 1.0);
     }
     guide.refine(&mut cut);
-    let s = guide.sampler(&cut);
+    let s = guide.vertex(&cut, &ShadingContext::at(Vec3::ZERO));
     assert!(!s.is_empty());
     for _ in 0..500 {
         let ctx = ShadingContext::on_surface(rng.point(8.0), rng.dir());
@@ -1399,9 +1400,19 @@ fn a_cut_as_a_light_sampler_answers_as_its_rules() {
     let dark_tree = LightTree::build(&dark, BuildHeuristic::Sarh).unwrap();
     let dark_rules = CutRules::new(&dark_tree, CutConfig::default()).unwrap();
     let dark_cut = dark_rules.new_cut();
-    assert!(dark_rules.is_empty() && dark_rules.sampler(&dark_cut).is_empty());
+    assert!(
+        dark_rules.is_empty()
+            && dark_rules
+                .vertex(&dark_cut, &ShadingContext::at(Vec3::ZERO))
+                .is_empty()
+    );
     let ctx = ShadingContext::at(Vec3::ZERO);
-    assert_eq!(dark_rules.sampler(&dark_cut).sample(&ctx, 0.5), None);
+    assert_eq!(
+        dark_rules
+            .vertex(&dark_cut, &ShadingContext::at(Vec3::ZERO))
+            .sample(&ctx, 0.5),
+        None
+    );
 }
 
 /// A light whose pmf rounds to 0 in `f32` is never returned, even by the
@@ -1553,11 +1564,11 @@ fn the_anchor_ignores_non_finite_positions() {
     let elsewhere = Vec3::new(-5.0, 5.0, -5.0);
     assert_eq!(
         guide.splat_from(&cut, elsewhere, LightId::Emitter(3), 0.0),
-        SplatOutcome::Zero
+        RecordOutcome::Zero
     );
     assert_eq!(
         guide.splat_from(&cut, elsewhere, LightId::Emitter(3), -1.0),
-        SplatOutcome::Dropped
+        RecordOutcome::Dropped
     );
     assert_eq!(cut.anchor(), Some(at));
 }
@@ -1574,27 +1585,26 @@ fn shared_splats_anchor_where_they_came_from() {
     let lights = lights_in_box(&mut rng, 30, 8.0);
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
     let config = GltConfig {
-        filter: SpatialFilter::Box,
+        light_filter: SpatialFilter::Box,
         spatial_threshold: 200.0,
         ..GltConfig::default()
     };
     let mut glt = Glt::new(&tree, common::scene(), config).unwrap();
-    let mut jitter = rand_pcg::Pcg32::new(1, 2);
     for _ in 0..3 {
         for _ in 0..3000 {
             let p = rng.point(9.0);
-            glt.splat(p, LightId::Emitter(rng.below(30)), 1.0, &mut jitter);
+            glt.record_light_at(p, LightId::Emitter(rng.below(30)), 1.0);
         }
         glt.refine();
     }
     let p = Vec3::new(0.013, -0.021, 0.017);
     for _ in 0..10 {
-        glt.splat(p, LightId::Emitter(4), 1.0, &mut jitter);
+        glt.record_light_at(p, LightId::Emitter(4), 1.0);
     }
     let mut anchored = 0;
     for d in [-0.4f32, 0.0, 0.4] {
         for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
-            let cut = glt.vertex(p + d * axis).unwrap().cut();
+            let cut = glt.vertex(&ShadingContext::at(p + d * axis)).unwrap().cut();
             if let Some(a) = cut.anchor() {
                 assert!((a - p).length() < 1e-5, "anchor {a} for splats from {p}");
                 anchored += 1;

@@ -4,7 +4,8 @@
 //! counted, threads equal a serial run, and the memory report.
 
 use glam::Vec3;
-use guiding::glt::{CutConfig, Glt, GltConfig, GltMemory, SplatOutcome};
+use guiding::RecordOutcome;
+use guiding::glt::{CutConfig, Glt, GltConfig, GltMemory};
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Accumulation;
 use guiding::spatial::SpatialFilter;
@@ -14,6 +15,7 @@ use guiding::{
 };
 
 mod common;
+use common::{ByPosition, LightsAt};
 use common::{Rand, scene, two_rooms, value};
 
 /// Trains `glt` for `iterations` iterations of `per_iteration` jittered
@@ -29,12 +31,12 @@ fn train<H: LightHierarchy>(
         for _ in 0..per_iteration {
             let p = rng.point(9.5);
             let ctx = ShadingContext::at(p);
-            let s = glt.sample(&ctx, rng.f()).unwrap();
+            let s = ByPosition(&*glt).sample(&ctx, rng.f()).unwrap();
             let LightId::Emitter(e) = s.light else {
                 panic!()
             };
             let v = value(lights, e, p) / s.pmf;
-            assert_ne!(glt.splat(p, s.light, v, &mut rng.0), SplatOutcome::Dropped);
+            assert_ne!(glt.record_light_at(p, s.light, v), RecordOutcome::Dropped);
         }
         glt.refine();
     }
@@ -75,7 +77,9 @@ fn learns_per_region_and_keeps_the_contract() {
         (Vec3::new(8.0, 1.0, -2.0), 40..80),
     ] {
         let ctx = ShadingContext::at(p);
-        let mass: f64 = own.map(|e| glt.pmf_exact(&ctx, LightId::Emitter(e))).sum();
+        let mass: f64 = own
+            .map(|e| ByPosition(&glt).pmf_exact(&ctx, LightId::Emitter(e)))
+            .sum();
         // The prior puts about half on each side; the floor alone keeps
         // alpha / 2 on the other.
         assert!(mass > 1.0 - alpha * 0.5 - 0.02, "mass {mass} at {p}");
@@ -83,18 +87,24 @@ fn learns_per_region_and_keeps_the_contract() {
     for _ in 0..20 {
         let ctx = ShadingContext::at(rng.point(12.0));
         let total: f64 = (0..80)
-            .map(|e| glt.pmf_exact(&ctx, LightId::Emitter(e)))
+            .map(|e| ByPosition(&glt).pmf_exact(&ctx, LightId::Emitter(e)))
             .sum();
         assert!((total - 1.0).abs() < 1e-5, "{total}");
-        assert_eq!(glt.pmf(&ctx, LightId::Unbounded(0)), 0.0);
+        assert_eq!(ByPosition(&glt).pmf(&ctx, LightId::Unbounded(0)), 0.0);
         for _ in 0..50 {
-            let s = glt.sample(&ctx, rng.f()).unwrap();
-            assert_eq!(s.pmf.to_bits(), glt.pmf(&ctx, s.light).to_bits());
-            let (light, p) = glt.sample_exact(&ctx, rng.f64()).unwrap();
-            assert_eq!(p.to_bits(), glt.pmf_exact(&ctx, light).to_bits());
+            let s = ByPosition(&glt).sample(&ctx, rng.f()).unwrap();
+            assert_eq!(
+                s.pmf.to_bits(),
+                ByPosition(&glt).pmf(&ctx, s.light).to_bits()
+            );
+            let (light, p) = ByPosition(&glt).sample_exact(&ctx, rng.f64()).unwrap();
+            assert_eq!(
+                p.to_bits(),
+                ByPosition(&glt).pmf_exact(&ctx, light).to_bits()
+            );
         }
     }
-    assert!(!glt.is_empty());
+    assert!(!ByPosition(&glt).is_empty());
 }
 
 /// When a cell splits, both halves start from a copy of its cut and
@@ -120,7 +130,7 @@ fn split_cells_inherit_the_cut_where_its_records_came_from() {
     let near = ShadingContext::at(p);
     let far = ShadingContext::at(Vec3::new(9.0, 9.0, 9.0));
     for _ in 0..1000 {
-        glt.splat_at(p, LightId::Emitter(3), 2.0);
+        glt.record_light_at(p, LightId::Emitter(3), 2.0);
     }
     glt.refine();
     let cells = glt.spatial().cell_count();
@@ -137,12 +147,15 @@ fn split_cells_inherit_the_cut_where_its_records_came_from() {
     };
     assert_eq!((at(&glt, &near), at(&glt, &far)), (1.0, 0.0));
     let alpha = glt.config().cut.alpha;
-    let p3 = glt.pmf_exact(&near, LightId::Emitter(3));
-    let untrained3 = prior.pmf_exact(&near, LightId::Emitter(3));
+    let p3 = ByPosition(&glt).pmf_exact(&near, LightId::Emitter(3));
+    let untrained3 = ByPosition(&prior).pmf_exact(&near, LightId::Emitter(3));
     assert!(p3 > 2.0 * untrained3, "{p3} against {untrained3}");
     for e in 0..lights.len() as u32 {
         let l = LightId::Emitter(e);
-        let (learned, untrained) = (glt.pmf_exact(&far, l), prior.pmf_exact(&far, l));
+        let (learned, untrained) = (
+            ByPosition(&glt).pmf_exact(&far, l),
+            ByPosition(&prior).pmf_exact(&far, l),
+        );
         assert!(
             (learned - untrained).abs() <= 1e-12 * untrained,
             "light {e}"
@@ -151,18 +164,18 @@ fn split_cells_inherit_the_cut_where_its_records_came_from() {
     // A round at the far corner: that cell learns from its own records.
     let q = far.position;
     for _ in 0..1000 {
-        glt.splat_at(q, LightId::Emitter(60), 2.0);
+        glt.record_light_at(q, LightId::Emitter(60), 2.0);
     }
     glt.refine();
     assert_eq!(at(&glt, &far), 1.0);
     let (p60, untrained60) = (
-        glt.pmf_exact(&far, LightId::Emitter(60)),
-        prior.pmf_exact(&far, LightId::Emitter(60)),
+        ByPosition(&glt).pmf_exact(&far, LightId::Emitter(60)),
+        ByPosition(&prior).pmf_exact(&far, LightId::Emitter(60)),
     );
     assert!(p60 > untrained60, "{p60} against {untrained60}");
     let room = |glt: &Glt<&LightTree>| -> f64 {
         (40..80)
-            .map(|e| glt.pmf_exact(&far, LightId::Emitter(e)))
+            .map(|e| ByPosition(glt).pmf_exact(&far, LightId::Emitter(e)))
             .sum()
     };
     assert!(
@@ -173,7 +186,9 @@ fn split_cells_inherit_the_cut_where_its_records_came_from() {
     );
     // The corner cell saw nothing new: it keeps what it learned.
     assert_eq!(
-        glt.pmf_exact(&near, LightId::Emitter(3)).to_bits(),
+        ByPosition(&glt)
+            .pmf_exact(&near, LightId::Emitter(3))
+            .to_bits(),
         p3.to_bits()
     );
 }
@@ -187,13 +202,13 @@ fn jitter_spreads_over_neighbouring_cells() {
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
     let config = GltConfig {
         spatial_threshold: 10.0,
-        filter: SpatialFilter::StochasticBox,
+        light_filter: SpatialFilter::StochasticBox,
         ..GltConfig::default()
     };
     let mut glt = Glt::new(&tree, scene(), config).unwrap();
     // Split the root once: cells meet at x = 0 (the cube is about [-10, 10]).
     for _ in 0..15 {
-        glt.splat_at(Vec3::ZERO, LightId::Emitter(0), 1.0);
+        glt.record_light_at(Vec3::ZERO, LightId::Emitter(0), 1.0);
     }
     glt.refine();
     assert_eq!(glt.spatial().cell_count(), 2);
@@ -204,9 +219,11 @@ fn jitter_spreads_over_neighbouring_cells() {
         .x;
     let p = Vec3::new(-0.25 * side, 0.0, 0.0);
     let here = glt.locate(p).unwrap();
-    let mut rng = Rand::new(3);
-    for _ in 0..4000 {
-        glt.splat(p, LightId::Emitter(1), 1.0, &mut rng.0);
+    // The offset is a hash of the record: records at points apart by a
+    // hair (along z, which does not move the box across the x border).
+    for k in 0..4000 {
+        let q = p + Vec3::new(0.0, 0.0, k as f32 * 1e-4);
+        glt.record_light_at(q, LightId::Emitter(1), 1.0);
     }
     let counts: Vec<u64> = glt
         .spatial()
@@ -219,17 +236,6 @@ fn jitter_spreads_over_neighbouring_cells() {
     // overlaps the neighbour by a quarter.
     let share = counts[other] as f64 / 4000.0;
     assert!((share - 0.25).abs() < 0.03, "{counts:?}");
-    for _ in 0..100 {
-        glt.splat_at(p, LightId::Emitter(1), 1.0);
-    }
-    let after: Vec<u64> = glt
-        .spatial()
-        .data_slice()
-        .iter()
-        .map(|c| c.splats())
-        .collect();
-    assert_eq!(after[other], counts[other]);
-    assert_eq!(after[here.index()], counts[here.index()] + 100);
 }
 
 /// Bad input is dropped and counted, never recorded: non-finite or
@@ -241,7 +247,6 @@ fn bad_splats_are_counted() {
     lights[5].power = 0.0;
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
     let mut glt = Glt::new(&tree, scene(), GltConfig::default()).unwrap();
-    let mut rng = Rand::new(5);
     let p = Vec3::ONE;
     let bad = [
         (p, LightId::Emitter(1), f32::NAN),
@@ -253,30 +258,38 @@ fn bad_splats_are_counted() {
         (p, LightId::Emitter(5), 1.0),
         (p, LightId::Unbounded(0), 1.0),
     ];
-    for (i, &(q, light, v)) in bad.iter().enumerate() {
-        assert_eq!(glt.splat(q, light, v, &mut rng.0), SplatOutcome::Dropped);
-        assert_eq!(glt.splat_at(q, light, v), SplatOutcome::Dropped);
-        assert_eq!(glt.dropped_splats().light, 2 * (i as u64 + 1));
+    for &(q, light, v) in &bad {
+        let before = glt.dropped_records();
+        assert_eq!(glt.record_light_at(q, light, v), RecordOutcome::Dropped);
+        assert_eq!(glt.record_light_at(q, light, v), RecordOutcome::Dropped);
+        // A non-finite point has no vertex: counted as a position.
+        let (light, position) = if q.is_finite() { (2, 0) } else { (0, 2) };
+        assert_eq!(glt.dropped_records().light, before.light + light);
+        assert_eq!(glt.dropped_records().position, before.position + position);
     }
     assert_eq!(
-        glt.splat_at(p, LightId::Emitter(1), 0.0),
-        SplatOutcome::Zero
+        glt.record_light_at(p, LightId::Emitter(1), 0.0),
+        RecordOutcome::Zero
     );
     assert_eq!(
-        glt.splat_at(p, LightId::Emitter(1), 1.0),
-        SplatOutcome::Recorded
+        glt.record_light_at(p, LightId::Emitter(1), 1.0),
+        RecordOutcome::Recorded
     );
-    assert_eq!(glt.dropped_splats().light, 16);
-    assert_eq!(glt.dropped_splats().total(), 16);
-    glt.reset_dropped_splats();
-    assert_eq!(glt.dropped_splats().total(), 0);
-    let (emitters, env) = glt.vertex(p).unwrap().cut().accumulated();
+    assert_eq!(glt.dropped_records().light, 14);
+    assert_eq!(glt.dropped_records().total(), 16);
+    glt.reset_dropped_records();
+    assert_eq!(glt.dropped_records().total(), 0);
+    let (emitters, env) = glt
+        .vertex(&ShadingContext::at(p))
+        .unwrap()
+        .cut()
+        .accumulated();
     assert_eq!((emitters, env), (1.0, 0.0));
     assert_eq!(glt.spatial().data_slice()[0].splats(), 2);
     // Queries at non-finite points: nothing, consistently.
     let nan = ShadingContext::at(Vec3::splat(f32::NAN));
-    assert!(glt.sample(&nan, 0.5).is_none());
-    assert_eq!(glt.pmf(&nan, LightId::Emitter(0)), 0.0);
+    assert!(ByPosition(&glt).sample(&nan, 0.5).is_none());
+    assert_eq!(ByPosition(&glt).pmf(&nan, LightId::Emitter(0)), 0.0);
 }
 
 /// A sun and a sky (two unbounded lights): each one's share is learned per
@@ -297,12 +310,12 @@ fn unbounded_shares_are_learned() {
     let ctx = ShadingContext::at(Vec3::ZERO);
     let (sky, sun) = (LightId::Unbounded(0), LightId::Unbounded(1));
     for light in [sky, sun] {
-        assert!((glt.pmf_exact(&ctx, light) - 0.15).abs() < 1e-7);
+        assert!((ByPosition(&glt).pmf_exact(&ctx, light) - 0.15).abs() < 1e-7);
     }
-    assert_eq!(glt.pmf(&ctx, LightId::Unbounded(2)), 0.0);
+    assert_eq!(ByPosition(&glt).pmf(&ctx, LightId::Unbounded(2)), 0.0);
     for _ in 0..100 {
-        glt.splat_at(Vec3::ZERO, sky, 3.0);
-        glt.splat_at(Vec3::ZERO, LightId::Emitter(7), 1.0);
+        glt.record_light_at(Vec3::ZERO, sky, 3.0);
+        glt.record_light_at(Vec3::ZERO, LightId::Emitter(7), 1.0);
     }
     glt.refine();
     // The sky took 3/4 of what the cell saw; the sun nothing, so it keeps
@@ -310,14 +323,17 @@ fn unbounded_shares_are_learned() {
     // floor its light would be lost, a bias).
     let alpha = glt.config().cut.alpha;
     let expect = [(1.0 - alpha) * 0.75 + alpha * 0.15, alpha * 0.15];
-    let got = [glt.pmf_exact(&ctx, sky), glt.pmf_exact(&ctx, sun)];
+    let got = [
+        ByPosition(&glt).pmf_exact(&ctx, sky),
+        ByPosition(&glt).pmf_exact(&ctx, sun),
+    ];
     for (g, e) in got.iter().zip(expect) {
         assert!((g - e).abs() < 1e-6, "{got:?} vs {expect:?}");
     }
     assert!(got[1] > 0.0);
     let total: f64 = got.iter().sum::<f64>()
         + (0..80)
-            .map(|e| glt.pmf_exact(&ctx, LightId::Emitter(e)))
+            .map(|e| ByPosition(&glt).pmf_exact(&ctx, LightId::Emitter(e)))
             .sum::<f64>();
     assert!((total - 1.0).abs() < 1e-6);
     // Sampling: each unbounded light is chosen at its pmf (3-sigma bounds
@@ -326,8 +342,8 @@ fn unbounded_shares_are_learned() {
     let mut hits = [0u32; 2];
     const N: u32 = 40_000;
     for _ in 0..N {
-        let s = glt.sample(&ctx, rng.f()).unwrap();
-        assert_eq!(s.pmf, glt.pmf(&ctx, s.light));
+        let s = ByPosition(&glt).sample(&ctx, rng.f()).unwrap();
+        assert_eq!(s.pmf, ByPosition(&glt).pmf(&ctx, s.light));
         match s.light {
             LightId::Unbounded(i) => hits[i as usize] += 1,
             LightId::Emitter(_) => {}
@@ -343,11 +359,14 @@ fn unbounded_shares_are_learned() {
     // The sun gets its own learned share once it is seen (twice the
     // records of the first round: the cell takes part again).
     for _ in 0..200 {
-        glt.splat_at(Vec3::ZERO, sun, 2.0);
-        glt.splat_at(Vec3::ZERO, sky, 2.0);
+        glt.record_light_at(Vec3::ZERO, sun, 2.0);
+        glt.record_light_at(Vec3::ZERO, sky, 2.0);
     }
     glt.refine();
-    let (a, b) = (glt.pmf_exact(&ctx, sky), glt.pmf_exact(&ctx, sun));
+    let (a, b) = (
+        ByPosition(&glt).pmf_exact(&ctx, sky),
+        ByPosition(&glt).pmf_exact(&ctx, sun),
+    );
     assert!((a - b).abs() < 1e-6 && a > 0.4, "{a} {b}");
 }
 
@@ -377,14 +396,14 @@ fn threads_equal_serial() {
     let mut parallel = Glt::new(&tree, scene(), config).unwrap();
     for chunk in stream.chunks(8000) {
         for &(p, e, v) in chunk {
-            serial.splat_at(p, LightId::Emitter(e), v);
+            serial.record_light_at(p, LightId::Emitter(e), v);
         }
         std::thread::scope(|s| {
             for t in 0..4 {
                 let glt = &parallel;
                 s.spawn(move || {
                     for &(p, e, v) in chunk.iter().skip(t).step_by(4) {
-                        glt.splat_at(p, LightId::Emitter(e), v);
+                        glt.record_light_at(p, LightId::Emitter(e), v);
                     }
                 });
             }
@@ -459,7 +478,7 @@ fn one_refinement_splits_as_deep_as_the_count_allows() {
     };
     let mut glt = Glt::new(&tree, scene(), config).unwrap();
     for _ in 0..1000 {
-        glt.splat_at(Vec3::new(-9.0, -9.0, -9.0), LightId::Emitter(3), 2.0);
+        glt.record_light_at(Vec3::new(-9.0, -9.0, -9.0), LightId::Emitter(3), 2.0);
     }
     let out = glt.refine();
     assert_eq!((out.splits, out.refused_by_budget), (15, 0));
@@ -469,7 +488,7 @@ fn one_refinement_splits_as_deep_as_the_count_allows() {
     // there, so any number makes it take part) split it once more, its
     // halves' 71 do not split them.
     for _ in 0..142 {
-        glt.splat_at(Vec3::new(9.0, 9.0, 9.0), LightId::Emitter(3), 2.0);
+        glt.record_light_at(Vec3::new(9.0, 9.0, 9.0), LightId::Emitter(3), 2.0);
     }
     assert_eq!(glt.refine().splits, 1);
     // The first corner's cell holds its share of the first 1,000: all of
@@ -478,10 +497,10 @@ fn one_refinement_splits_as_deep_as_the_count_allows() {
     // 749 more splats do not make it take part, 750 do.
     let corner = Vec3::new(-9.0, -9.0, -9.0);
     for _ in 0..749 {
-        glt.splat_at(corner, LightId::Emitter(3), 2.0);
+        glt.record_light_at(corner, LightId::Emitter(3), 2.0);
     }
     assert_eq!(glt.refine().splits, 0);
-    glt.splat_at(corner, LightId::Emitter(3), 2.0);
+    glt.record_light_at(corner, LightId::Emitter(3), 2.0);
     assert!(glt.refine().splits > 0);
 }
 
@@ -516,8 +535,8 @@ fn owns_or_shares_its_light_tree() {
     for _ in 0..200 {
         let ctx = ShadingContext::at(rng.point(9.5));
         let u = rng.f();
-        let s = borrowed.sample(&ctx, u);
-        assert_eq!(r.guide.sample(&ctx, u), s);
-        assert_eq!(r.owned.sample(&ctx, u), s);
+        let s = ByPosition(&borrowed).sample(&ctx, u);
+        assert_eq!(ByPosition(&r.guide).sample(&ctx, u), s);
+        assert_eq!(ByPosition(&r.owned).sample(&ctx, u), s);
     }
 }

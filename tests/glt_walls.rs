@@ -13,6 +13,7 @@
 //! from every light's contribution.
 
 mod common;
+use common::{ByPosition, LightsAt};
 
 use common::Rand;
 use glam::Vec3;
@@ -136,7 +137,7 @@ fn dim_room_ratio(config: CutConfig, filter: SpatialFilter) -> f64 {
             cut: config,
             spatial_threshold: 400.0,
             max_bytes: None,
-            filter,
+            light_filter: filter,
         },
     )
     .unwrap();
@@ -147,9 +148,9 @@ fn dim_room_ratio(config: CutConfig, filter: SpatialFilter) -> f64 {
             let p = floor_point(&mut rng, room);
             let ctx = ShadingContext::on_surface(p, Vec3::Y);
             if let Some((light, value)) = bsdf_hit(&lights, p, &mut rng) {
-                glt.splat(p, LightId::Emitter(light), value as f32, &mut rng.0);
+                glt.record_light_at(p, LightId::Emitter(light), value as f32);
             }
-            let Some(s) = glt.sample(&ctx, rng.f()) else {
+            let Some(s) = ByPosition(&glt).sample(&ctx, rng.f()) else {
                 continue;
             };
             let LightId::Emitter(e) = s.light else {
@@ -157,7 +158,7 @@ fn dim_room_ratio(config: CutConfig, filter: SpatialFilter) -> f64 {
             };
             let c = contribution(&lights[e as usize], p);
             if c > 0.0 {
-                glt.splat(p, s.light, (c / s.pmf as f64) as f32, &mut rng.0);
+                glt.record_light_at(p, s.light, (c / s.pmf as f64) as f32);
             }
         }
         glt.refine();
@@ -167,7 +168,7 @@ fn dim_room_ratio(config: CutConfig, filter: SpatialFilter) -> f64 {
     for _ in 0..200 {
         let p = floor_point(&mut rng, DIM);
         let ctx = ShadingContext::on_surface(p, Vec3::Y);
-        v_glt += variance(&lights, p, |l| glt.pmf_exact(&ctx, l));
+        v_glt += variance(&lights, p, |l| ByPosition(&glt).pmf_exact(&ctx, l));
         v_power += variance(&lights, p, |l| f64::from(power.pmf(&ctx, l)));
     }
     v_glt / v_power
@@ -179,7 +180,7 @@ fn dim_room_ratio(config: CutConfig, filter: SpatialFilter) -> f64 {
 /// a change that triples either fails here), with and without modulation.
 #[test]
 fn dim_room_beside_bright_rooms_learns_its_own_lights() {
-    let filter = GltConfig::default().filter;
+    let filter = GltConfig::default().light_filter;
     for modulation in [Modulation::None, Modulation::Importance] {
         let config = CutConfig {
             modulation,

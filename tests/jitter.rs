@@ -1,71 +1,74 @@
-//! Jittered splats take their random numbers from any `rand_core`
-//! generator or from three numbers the renderer drew itself.
+//! The stochastic box filter draws its offset from a hash of the record
+//! (`src/spatial/jitter.rs`), not from a generator the renderer passes:
+//! the same records learn the same state in any order, and the filter
+//! still moves records into the neighbouring cells.
 
 mod common;
 
-use common::{Rand, scene};
+use common::{DirectionsAt, Rand, scene};
 use glam::Vec3;
+use guiding::RecordOutcome;
+use guiding::math::Accumulation;
 use guiding::quadtree::UNIFORM_PDF;
 use guiding::sd_tree::{SdTree, SdTreeConfig};
-use guiding::spatial::{JitterNumbers, SpatialFilter};
+use guiding::spatial::SpatialFilter;
 
+/// A tree of a few cells, split by records at scattered points.
 fn tree(filter: SpatialFilter) -> SdTree {
     let config = SdTreeConfig {
         spatial_threshold: 50.0,
         spatial_filter: filter,
+        accumulation: Accumulation::Deterministic,
         ..SdTreeConfig::default()
     };
-    let mut t = SdTree::new(scene(), config).unwrap();
-    // Split the scene into a few cells first (centred jitter: the same
-    // cells whatever the filter).
+    let t = SdTree::new(scene(), config).unwrap();
     let mut rng = Rand::new(1);
     for _ in 0..2000 {
-        let centre = &mut JitterNumbers([0.5; 3]);
-        t.splat(rng.point(9.5), Vec3::Y, 1.0, UNIFORM_PDF, centre);
+        t.record_radiance_at(rng.point(9.5), Vec3::Y, 1.0, UNIFORM_PDF);
     }
-    t.refine();
     t
 }
 
+/// Every cell's learned pdf along some directions, bit for bit.
+fn learned(t: &SdTree) -> Vec<u32> {
+    let mut rng = Rand::new(7);
+    (0..300)
+        .map(|_| t.direction_pdf_at(rng.point(9.5), rng.dir()).to_bits())
+        .collect()
+}
+
 #[test]
-fn centred_numbers_splat_like_nearest_and_others_move() {
-    let (mut a, mut b, mut c) = (
+fn the_same_records_in_any_order_learn_the_same_and_the_box_moves_them() {
+    let (mut forward, mut backward, mut nearest) = (
+        tree(SpatialFilter::StochasticBox),
         tree(SpatialFilter::StochasticBox),
         tree(SpatialFilter::Nearest),
-        tree(SpatialFilter::StochasticBox),
     );
-    assert!(a.cell_count() > 4);
-    assert_eq!(a.cell_count(), b.cell_count());
-    // And any rand_core generator drives it too.
-    assert!(c.splat(
-        Vec3::ZERO,
-        Vec3::Y,
-        0.0,
-        UNIFORM_PDF,
-        &mut rand_pcg::Pcg32::new(1, 1)
-    ));
+    for t in [&mut forward, &mut backward, &mut nearest] {
+        t.refine();
+        assert!(t.cell_count() > 4);
+    }
     let mut rng = Rand::new(2);
-    for _ in 0..2000 {
-        let p = rng.point(9.5);
-        let d = rng.dir();
-        // The box's centre is the point itself: the nearest cell.
-        assert!(a.splat(p, d, 1.0, UNIFORM_PDF, &mut JitterNumbers([0.5; 3])));
-        assert!(b.splat(p, d, 1.0, UNIFORM_PDF, &mut JitterNumbers([0.0; 3])));
-        // A corner of the box: a neighbouring cell near the cell's faces.
-        let nan = JitterNumbers([f32::NAN, 7.0, -1.0]);
-        assert!(c.splat(p, d, 1.0, UNIFORM_PDF, &mut { nan }));
+    let records: Vec<(Vec3, Vec3)> = (0..3000).map(|_| (rng.point(9.5), rng.dir())).collect();
+    for (p, d) in &records {
+        assert_eq!(
+            forward.record_radiance_at(*p, *d, 1.0, UNIFORM_PDF),
+            RecordOutcome::Recorded
+        );
+        assert_eq!(
+            nearest.record_radiance_at(*p, *d, 1.0, UNIFORM_PDF),
+            RecordOutcome::Recorded
+        );
     }
-    a.refine();
-    b.refine();
-    c.refine();
-    let mut same_ab = true;
-    let mut same_ac = true;
-    for _ in 0..300 {
-        let p = rng.point(9.5);
-        let d = rng.dir();
-        same_ab &= a.pdf(p, d).to_bits() == b.pdf(p, d).to_bits();
-        same_ac &= a.pdf(p, d).to_bits() == c.pdf(p, d).to_bits();
+    for (p, d) in records.iter().rev() {
+        backward.record_radiance_at(*p, *d, 1.0, UNIFORM_PDF);
     }
-    assert!(same_ab, "centred jitter must equal the nearest cell");
-    assert!(!same_ac, "a corner jitter must reach other cells");
+    for t in [&mut forward, &mut backward, &mut nearest] {
+        t.refine();
+    }
+    // No generator, no order: the jitter is the record's own.
+    assert_eq!(learned(&forward), learned(&backward));
+    // The control: the box did move records out of their cells (a filter
+    // that ignored its offset would learn what the nearest cell learns).
+    assert_ne!(learned(&forward), learned(&nearest));
 }

@@ -6,6 +6,7 @@
 //! of the same records does exceed it, so the bound is not vacuous.
 
 mod common;
+use common::{ByPosition, LightsAt};
 
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
@@ -59,8 +60,8 @@ fn train_glt(lights: &[Emitter], tree: &LightTree, max_bytes: Option<usize>) -> 
     for _ in 0..5 {
         for _ in 0..20_000 {
             let p = rng.point(9.5);
-            let (light, v) = light_record(&glt, lights, p, &mut rng);
-            glt.splat(p, light, v, &mut rng.0);
+            let (light, v) = light_record(&ByPosition(&glt), lights, p, &mut rng);
+            glt.record_light_at(p, light, v);
         }
         glt.refine();
         after.push(glt_bytes(&glt));
@@ -69,7 +70,7 @@ fn train_glt(lights: &[Emitter], tree: &LightTree, max_bytes: Option<usize>) -> 
         }
         let ctx = ShadingContext::at(rng.point(9.0));
         let total: f64 = (0..80)
-            .map(|e| glt.pmf_exact(&ctx, LightId::Emitter(e)))
+            .map(|e| ByPosition(&glt).pmf_exact(&ctx, LightId::Emitter(e)))
             .sum();
         assert!((total - 1.0).abs() < 1e-6);
     }
@@ -106,11 +107,13 @@ fn train_sd(max_bytes: Option<usize>) -> Vec<usize> {
         for _ in 0..20_000 {
             let p = rng.point(9.5);
             let (d, v) = radiance_record(&mut rng);
-            sd.vertex(p).unwrap().splat_radiance(d, v, 1.0, &mut rng.0);
+            sd.vertex(&ShadingContext::at(p))
+                .unwrap()
+                .record_radiance(d, v, 1.0);
         }
         sd.refine();
         after.push(sd.memory().total());
-        let v = sd.vertex(rng.point(9.0)).unwrap();
+        let v = sd.vertex(&ShadingContext::at(rng.point(9.0))).unwrap();
         let (d, pdf) = v.sample_direction([rng.f(), rng.f()]);
         assert!(pdf > 0.0 && pdf.is_finite() && (v.direction_pdf(d) - pdf).abs() <= 1e-4 * pdf);
     }
@@ -146,11 +149,11 @@ fn train_field(lights: &[Emitter], tree: &LightTree, max_bytes: Option<usize>) -
     for _ in 0..5 {
         for _ in 0..20_000 {
             let p = rng.point(9.5);
-            let v = field.vertex(p).unwrap();
-            let (light, value) = light_record(&v, lights, p, &mut rng);
-            v.splat_light(light, value, &mut rng.0);
+            let v = field.vertex(&ShadingContext::at(p)).unwrap();
+            let (light, value) = light_record(&v.light, lights, p, &mut rng);
+            v.light.record_light(light, value);
             let (d, r) = radiance_record(&mut rng);
-            v.splat_radiance(d, r, 1.0, &mut rng.0);
+            v.direction.record_radiance(d, r, 1.0);
         }
         field.refine();
         after.push(field.memory().capped());

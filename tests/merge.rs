@@ -5,6 +5,8 @@
 //! structures is refused and changes nothing.
 
 mod common;
+use common::LightsAt;
+use guiding::ShadingContext;
 
 use common::{Rand, scene, two_rooms, unshadowed, value};
 use glam::Vec3;
@@ -13,7 +15,6 @@ use guiding::glt::{CutConfig, Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Accumulation;
 use guiding::sd_tree::{SdTree, SdTreeConfig};
-use guiding::spatial::JitterNumbers;
 use guiding::{LightId, LightTree};
 
 /// One sample's records: a position, a light and its value, a direction
@@ -27,7 +28,6 @@ struct Sample {
     unshadowed: f32,
     dir: Vec3,
     radiance: f32,
-    jitter: [f32; 3],
 }
 
 fn samples(seed: u64, n: usize) -> Vec<Sample> {
@@ -46,7 +46,6 @@ fn samples(seed: u64, n: usize) -> Vec<Sample> {
                 unshadowed: unshadowed(&lights, light, p) * f,
                 dir,
                 radiance: 1.0 + 30.0 * dir.y.max(0.0).powi(6),
-                jitter: [rng.f(), rng.f(), rng.f()],
             }
         })
         .collect()
@@ -64,8 +63,8 @@ trait Farmable: Sized {
 
 impl Farmable for Glt<&'static LightTree> {
     fn record(&self, s: &Sample) {
-        self.splat_at(s.p, LightId::Emitter(s.light), s.light_value);
-        self.splat_visibility(s.p, LightId::Emitter(s.light), s.light_value, s.unshadowed);
+        self.record_light_at(s.p, LightId::Emitter(s.light), s.light_value);
+        self.record_visibility_at(s.p, LightId::Emitter(s.light), s.light_value, s.unshadowed);
     }
     fn clear(&mut self) {
         self.clear_records();
@@ -86,8 +85,8 @@ impl Farmable for Glt<&'static LightTree> {
 
 impl Farmable for SdTree {
     fn record(&self, s: &Sample) {
-        let v = self.vertex(s.p).unwrap();
-        v.splat_radiance(s.dir, s.radiance, 0.4, &mut JitterNumbers(s.jitter));
+        let v = self.vertex(&ShadingContext::at(s.p)).unwrap();
+        v.record_radiance(s.dir, s.radiance, 0.4);
         v.record_fraction(0.3, 0.5, s.radiance);
     }
     fn clear(&mut self) {
@@ -109,14 +108,12 @@ impl Farmable for SdTree {
 
 impl Farmable for GuidingField<&'static LightTree> {
     fn record(&self, s: &Sample) {
-        let v = self.vertex(s.p).unwrap();
-        v.splat_light(
-            LightId::Emitter(s.light),
-            s.light_value,
-            &mut JitterNumbers(s.jitter),
-        );
-        v.splat_visibility(LightId::Emitter(s.light), s.light_value, s.unshadowed);
-        v.splat_radiance(s.dir, s.radiance, 0.4, &mut JitterNumbers(s.jitter));
+        let v = self.vertex(&ShadingContext::at(s.p)).unwrap();
+        v.light
+            .record_light(LightId::Emitter(s.light), s.light_value);
+        v.light
+            .record_visibility(LightId::Emitter(s.light), s.light_value, s.unshadowed);
+        v.direction.record_radiance(s.dir, s.radiance, 0.4);
     }
     fn clear(&mut self) {
         self.clear_records();
@@ -308,10 +305,10 @@ fn cuts_with_equal_nodes_that_sample_differently_refuse_to_merge() {
         for k in 0..4000u32 {
             let p = Vec3::new(-4.0, 0.0, 1.0);
             let light = LightId::Emitter(k % n);
-            glt.splat_at(p, light, 1.0);
+            glt.record_light_at(p, light, 1.0);
             let seen = if k % 8 < shadowed { 0.0 } else { 1.0 };
-            glt.splat_visibility(p, light, seen, 1.0);
-            glt.splat_at(p, LightId::Unbounded(0), sky);
+            glt.record_visibility_at(p, light, seen, 1.0);
+            glt.record_light_at(p, LightId::Unbounded(0), sky);
         }
         glt.refine();
         glt
@@ -358,8 +355,8 @@ fn mismatched_fields_refuse_to_merge() {
             field.record(s);
         }
         for s in stream.iter().take(50) {
-            let v = field.vertex(s.p).unwrap();
-            v.splat_light(LightId::Unbounded(0), sky, &mut JitterNumbers(s.jitter));
+            let v = field.vertex(&ShadingContext::at(s.p)).unwrap();
+            v.light.record_light(LightId::Unbounded(0), sky);
         }
         if refine {
             field.refine();

@@ -5,14 +5,12 @@
 
 mod common;
 
-use common::Rand;
+use common::{DirectionsAt, Rand};
 use glam::Vec3;
-use guiding::math::Aabb;
-use guiding::path_recorder::{RadianceRecords, Segment};
+use guiding::math::{Aabb, Accumulation};
+use guiding::path_recorder::luminance;
 use guiding::sd_tree::{SdTree, SdTreeConfig};
-use guiding::spatial::Jitter;
-use guiding::{PathRecorder, mis};
-use std::cell::RefCell;
+use guiding::{PathRecorder, ShadingContext, mis};
 
 /// One event of a random path.
 #[derive(Clone, Copy, Debug)]
@@ -20,24 +18,6 @@ enum Event {
     Found(Vec3),
     Segment(Vec3),
     Specular(Vec3),
-}
-
-/// Collects what the recorder delivers.
-#[derive(Default)]
-struct Collect(RefCell<Vec<(u32, Vec3, f32, f32)>>);
-
-impl RadianceRecords<u32> for Collect {
-    fn record<J: Jitter + ?Sized>(
-        &self,
-        s: &Segment<u32>,
-        radiance: f32,
-        contribution: f32,
-        _: &mut J,
-    ) {
-        self.0
-            .borrow_mut()
-            .push((s.cell, s.incident, radiance, contribution));
-    }
 }
 
 fn colour(rng: &mut Rand) -> Vec3 {
@@ -56,7 +36,7 @@ fn colour(rng: &mut Rand) -> Vec3 {
 #[test]
 fn matches_the_definition_on_random_paths() {
     let mut rng = Rand::new(11);
-    let mut recorder = PathRecorder::<u32>::new();
+    let mut recorder = PathRecorder::new();
     for _ in 0..500 {
         let events: Vec<Event> = (0..rng.below(12) + 1)
             .map(|_| match rng.below(3) {
@@ -71,7 +51,7 @@ fn matches_the_definition_on_random_paths() {
             match *e {
                 Event::Found(c) => recorder.add_radiance(c),
                 Event::Segment(w) => {
-                    recorder.push_segment(segments, Vec3::ZERO, Vec3::Z, 1.0, 0.5, 0.5, w);
+                    recorder.push_segment(None, Vec3::Z, 1.0, 0.5, 0.5, w);
                     segments += 1;
                 }
                 Event::Specular(w) => recorder.scatter_unrecorded(w),
@@ -112,17 +92,14 @@ fn matches_the_definition_on_random_paths() {
         let close =
             |a: Vec3, b: Vec3| (a - b).abs().max_element() <= 1e-5 * (1.0 + b.abs().max_element());
         assert!(close(recorder.estimate(), pixel), "{events:?}");
-        let sink = Collect::default();
-        recorder.finish(&sink, &mut rand_pcg::Pcg32::new(1, 1));
-        let got = sink.0.into_inner();
+        recorder.finish();
+        let got = recorder.segments();
         assert_eq!(got.len(), segments as usize);
-        for (k, (cell, inc, radiance, contribution)) in got.into_iter().enumerate() {
-            assert_eq!(cell, k as u32);
-            assert!(close(inc, incident(k as u32)), "{events:?} segment {k}");
-            let w = recorder.segments()[k].weight;
-            let lum = |c: Vec3| 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
-            assert_eq!(radiance, lum(inc));
-            assert_eq!(contribution, lum(w * inc));
+        for (k, s) in got.iter().enumerate() {
+            assert!(
+                close(s.incident, incident(k as u32)),
+                "{events:?} segment {k}"
+            );
         }
     }
 }
@@ -133,51 +110,83 @@ fn matches_the_definition_on_random_paths() {
 /// would lose it where the throughput is zero).
 #[test]
 fn a_zero_channel_loses_nothing_else() {
-    let mut r = PathRecorder::<u32>::new();
-    r.push_segment(
-        0,
-        Vec3::ZERO,
-        Vec3::Z,
-        1.0,
-        1.0,
-        0.0,
-        Vec3::new(0.0, 1.0, 1.0),
-    );
-    r.push_segment(
-        1,
-        Vec3::ZERO,
-        Vec3::Z,
-        1.0,
-        1.0,
-        0.0,
-        Vec3::new(1.0, 0.5, 1.0),
-    );
+    let mut r = PathRecorder::new();
+    r.push_segment(None, Vec3::Z, 1.0, 1.0, 0.0, Vec3::new(0.0, 1.0, 1.0));
+    r.push_segment(None, Vec3::Z, 1.0, 1.0, 0.0, Vec3::new(1.0, 0.5, 1.0));
     r.add_radiance(Vec3::new(4.0, 2.0, 0.0));
     r.add_radiance(Vec3::NAN); // ignored
-    let sink = Collect::default();
-    r.finish(&sink, &mut rand_pcg::Pcg32::new(1, 1));
-    let got = sink.0.into_inner();
-    assert_eq!(got[1].1, Vec3::new(4.0, 2.0, 0.0));
-    assert_eq!(got[0].1, Vec3::new(4.0, 1.0, 0.0));
+    r.finish();
+    let got = r.segments();
+    assert_eq!(got[1].incident, Vec3::new(4.0, 2.0, 0.0));
+    assert_eq!(got[0].incident, Vec3::new(4.0, 1.0, 0.0));
     assert_eq!(r.estimate(), Vec3::new(0.0, 1.0, 0.0));
 }
 
-/// Into an SD-tree: the records land in the cell and direction they name.
+/// Into an SD-tree: each segment's vertex gets exactly the two records a
+/// renderer would make by hand (PPG's radiance record of the luminance of
+/// the incident radiance with the segment's pdf, the fraction record of
+/// its two pdfs and the luminance of weight times incident radiance), so
+/// the learned state is bit for bit the same; the control, a recorder that
+/// delivered the throughput-weighted radiance instead, learns otherwise.
 #[test]
 fn records_into_an_sd_tree() {
     let scene = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
-    let mut tree = SdTree::new(scene, SdTreeConfig::default()).unwrap();
+    let config = SdTreeConfig {
+        learn_bsdf_fraction: true,
+        accumulation: Accumulation::Deterministic,
+        ..SdTreeConfig::default()
+    };
+    let (mut by_recorder, mut by_hand, mut control) = (
+        SdTree::new(scene, config).unwrap(),
+        SdTree::new(scene, config).unwrap(),
+        SdTree::new(scene, config).unwrap(),
+    );
     let mut r = PathRecorder::new();
-    let mut rng = rand_pcg::Pcg32::new(3, 7);
+    let mut rng = Rand::new(3);
     for _ in 0..2000 {
+        let (p, q) = (rng.point(0.9), rng.point(0.9));
+        let (d0, d1) = (rng.dir(), rng.dir());
+        let (w0, w1) = (colour(&mut rng), colour(&mut rng));
+        let (e0, e1) = (colour(&mut rng), colour(&mut rng));
         r.clear();
-        r.push_segment((), Vec3::ZERO, Vec3::Y, 0.25, 0.25, 0.0, Vec3::ONE);
-        r.add_radiance(Vec3::splat(1.0));
-        r.finish(&tree, &mut rng);
+        r.push_segment(
+            by_recorder.vertex(&ShadingContext::at(p)),
+            d0,
+            0.25,
+            0.3,
+            0.1,
+            w0,
+        );
+        r.add_radiance(e0);
+        r.push_segment(
+            by_recorder.vertex(&ShadingContext::at(q)),
+            d1,
+            0.5,
+            0.2,
+            0.4,
+            w1,
+        );
+        r.add_radiance(e1);
+        r.finish();
+        // By hand: L_1 = e1, L_0 = e0 + w1 e1.
+        let (l0, l1) = (e0 + w1 * e1, e1);
+        for (t, weigh) in [(&by_hand, false), (&control, true)] {
+            let v = t.direction_at(p);
+            let l = if weigh { w0 * l0 } else { l0 };
+            v.record_radiance(d0, luminance(l), 0.25);
+            v.record_fraction(0.3, 0.1, luminance(w0 * l0));
+            let v = t.direction_at(q);
+            let l = if weigh { w1 * l1 } else { l1 };
+            v.record_radiance(d1, luminance(l), 0.5);
+            v.record_fraction(0.2, 0.4, luminance(w1 * l1));
+        }
     }
-    assert_eq!(tree.dropped_splats().total(), 0);
-    tree.refine();
-    assert!(tree.pdf(Vec3::ZERO, Vec3::Y) > 10.0 * tree.pdf(Vec3::ZERO, -Vec3::Y));
+    assert_eq!(by_recorder.dropped_records().total(), 0);
+    for t in [&mut by_recorder, &mut by_hand, &mut control] {
+        t.refine();
+    }
+    assert_eq!(by_recorder.to_bytes(), by_hand.to_bytes());
+    assert_ne!(by_recorder.to_bytes(), control.to_bytes());
     // MIS weights of the two techniques sum to one.
     let (a, b) = (0.3, 1.7);
     assert!((mis::power_heuristic(a, b) + mis::power_heuristic(b, a) - 1.0).abs() < 1e-6);

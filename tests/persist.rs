@@ -4,6 +4,7 @@
 //! parse, structures that keep every contract), never a panic.
 
 mod common;
+use common::{ByPosition, LightsAt};
 
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
@@ -73,12 +74,14 @@ fn train<H: guiding::LightHierarchy>(
 fn record<H: guiding::LightHierarchy>(glt: &Glt<H>, lights: &[Emitter], rng: &mut Rand, n: usize) {
     for i in 0..n {
         let p = rng.point(9.5);
-        let x = glt.sample(&ShadingContext::at(p), rng.f()).unwrap();
+        let x = ByPosition(glt)
+            .sample(&ShadingContext::at(p), rng.f())
+            .unwrap();
         let v = match x.light {
             LightId::Emitter(e) => value(lights, e, p) / x.pmf,
             LightId::Unbounded(_) => (i % 3) as f32,
         };
-        glt.splat_at(p, x.light, v);
+        glt.record_light_at(p, x.light, v);
     }
 }
 
@@ -92,11 +95,14 @@ fn assert_same_answers<H: guiding::LightHierarchy>(a: &Glt<H>, b: &Glt<H>, seed:
     for _ in 0..300 {
         let ctx = ShadingContext::on_surface(rng.point(11.0), rng.dir());
         let u = rng.f64();
-        assert_eq!(a.sample_exact(&ctx, u), b.sample_exact(&ctx, u));
+        assert_eq!(
+            ByPosition(a).sample_exact(&ctx, u),
+            ByPosition(b).sample_exact(&ctx, u)
+        );
         let l = lights[rng.below(lights.len() as u32) as usize];
         assert_eq!(
-            a.pmf_exact(&ctx, l).to_bits(),
-            b.pmf_exact(&ctx, l).to_bits()
+            ByPosition(a).pmf_exact(&ctx, l).to_bits(),
+            ByPosition(b).pmf_exact(&ctx, l).to_bits()
         );
     }
 }
@@ -134,7 +140,7 @@ fn glt_round_trips_and_learns_on_identically() {
             let mut back = Glt::from_bytes(&bytes, &tree).unwrap();
             assert_same_answers(&glt, &back, 2);
             assert_eq!(back.to_bytes(), bytes);
-            assert_eq!(back.dropped_splats(), glt.dropped_splats());
+            assert_eq!(back.dropped_records(), glt.dropped_records());
             // Both go on learning from the same records: still the same.
             let mut rng = (Rand::new(3), Rand::new(3));
             record(&glt, &lights, &mut rng.0, 4000);
@@ -314,14 +320,14 @@ fn assert_contract<H: guiding::LightHierarchy>(glt: &Glt<H>, n: u32, rng: &mut R
     for _ in 0..4 {
         let ctx = ShadingContext::at(rng.point(10.0));
         let total: f64 = (0..n)
-            .map(|e| glt.pmf_exact(&ctx, LightId::Emitter(e)))
+            .map(|e| ByPosition(glt).pmf_exact(&ctx, LightId::Emitter(e)))
             .sum::<f64>()
             + (0..3)
-                .map(|i| glt.pmf_exact(&ctx, LightId::Unbounded(i)))
+                .map(|i| ByPosition(glt).pmf_exact(&ctx, LightId::Unbounded(i)))
                 .sum::<f64>();
         assert!((total - 1.0).abs() < 1e-5, "{total}");
-        if let Some(x) = glt.sample(&ctx, rng.f()) {
-            assert_eq!(x.pmf, glt.pmf(&ctx, x.light));
+        if let Some(x) = ByPosition(glt).sample(&ctx, rng.f()) {
+            assert_eq!(x.pmf, ByPosition(glt).pmf(&ctx, x.light));
         }
     }
 }
@@ -423,9 +429,9 @@ mod sd_and_field {
     fn train_sd(sd: &SdTree, rng: &mut Rand, n: usize) {
         for _ in 0..n {
             let p = rng.point(9.5);
-            let v = sd.vertex(p).unwrap();
+            let v = sd.vertex(&ShadingContext::at(p)).unwrap();
             let (d, r) = radiance(rng);
-            v.splat_radiance(d, r, 0.3, &mut rng.0);
+            v.record_radiance(d, r, 0.3);
             v.record_fraction(0.2, 0.4, r);
         }
     }
@@ -434,7 +440,10 @@ mod sd_and_field {
         let mut rng = Rand::new(seed);
         for _ in 0..300 {
             let p = rng.point(11.0);
-            let (va, vb) = (a.vertex(p).unwrap(), b.vertex(p).unwrap());
+            let (va, vb) = (
+                a.vertex(&ShadingContext::at(p)).unwrap(),
+                b.vertex(&ShadingContext::at(p)).unwrap(),
+            );
             let u = [rng.f(), rng.f()];
             let (da, pa) = va.sample_direction(u);
             let (db, pb) = vb.sample_direction(u);
@@ -490,15 +499,15 @@ mod sd_and_field {
             for _ in 0..3 {
                 for _ in 0..4000 {
                     let p = rng.point(9.5);
-                    let v = field.vertex(p).unwrap();
-                    let x = v.sample(&ShadingContext::at(p), rng.f()).unwrap();
+                    let v = field.vertex(&ShadingContext::at(p)).unwrap();
+                    let x = v.light.sample(&ShadingContext::at(p), rng.f()).unwrap();
                     let val = match x.light {
                         LightId::Emitter(e) => value(&lights, e, p) / x.pmf,
                         LightId::Unbounded(_) => 0.5,
                     };
-                    v.splat_light(x.light, val, &mut rng.0);
+                    v.light.record_light(x.light, val);
                     let (d, r) = radiance(&mut rng);
-                    v.splat_radiance(d, r, 0.3, &mut rng.0);
+                    v.direction.record_radiance(d, r, 0.3);
                 }
                 field.refine();
             }
@@ -510,10 +519,19 @@ mod sd_and_field {
                 let p = rng.point(11.0);
                 let ctx = ShadingContext::on_surface(p, rng.dir());
                 let u = rng.f64();
-                assert_eq!(field.sample_exact(&ctx, u), back.sample_exact(&ctx, u));
-                let (a, b) = (field.vertex(p).unwrap(), back.vertex(p).unwrap());
+                assert_eq!(
+                    ByPosition(&field).sample_exact(&ctx, u),
+                    ByPosition(&back).sample_exact(&ctx, u)
+                );
+                let (a, b) = (
+                    field.vertex(&ShadingContext::at(p)).unwrap(),
+                    back.vertex(&ShadingContext::at(p)).unwrap(),
+                );
                 let d = rng.dir();
-                assert_eq!(a.direction_pdf(d).to_bits(), b.direction_pdf(d).to_bits());
+                assert_eq!(
+                    a.direction.direction_pdf(d).to_bits(),
+                    b.direction.direction_pdf(d).to_bits()
+                );
             }
             let mut other = lights.clone();
             other.pop();
@@ -545,10 +563,10 @@ mod sd_and_field {
         for _ in 0..2 {
             for _ in 0..200 {
                 let p = rng.point(9.5);
-                let v = field.vertex(p).unwrap();
+                let v = field.vertex(&ShadingContext::at(p)).unwrap();
                 let (d, r) = radiance(&mut rng);
-                v.splat_radiance(d, r, 0.3, &mut rng.0);
-                v.splat_light(LightId::Emitter(rng.below(4)), 1.0, &mut rng.0);
+                v.direction.record_radiance(d, r, 0.3);
+                v.light.record_light(LightId::Emitter(rng.below(4)), 1.0);
             }
             field.refine();
         }
@@ -570,12 +588,14 @@ mod sd_and_field {
                 loaded += 1;
                 let p = rng.point(9.0);
                 let ctx = ShadingContext::at(p);
-                let total: f64 = (0..4).map(|e| f.pmf_exact(&ctx, LightId::Emitter(e))).sum();
+                let total: f64 = (0..4)
+                    .map(|e| ByPosition(&f).pmf_exact(&ctx, LightId::Emitter(e)))
+                    .sum();
                 assert!((total - 1.0).abs() < 1e-5);
-                let v = f.vertex(p).unwrap();
-                let (d, pdf) = v.sample_direction([rng.f(), rng.f()]);
+                let v = f.vertex(&ShadingContext::at(p)).unwrap();
+                let (d, pdf) = v.direction.sample_direction([rng.f(), rng.f()]);
                 assert!(pdf > 0.0 && pdf.is_finite(), "{pdf}");
-                assert!((v.direction_pdf(d) - pdf).abs() <= 1e-3 * pdf);
+                assert!((v.direction.direction_pdf(d) - pdf).abs() <= 1e-3 * pdf);
             }
         }
         assert!(loaded > 0);

@@ -7,6 +7,7 @@
 //! are ignored, never kept; the choice is deterministic.
 
 mod common;
+use common::{ByPosition, LightsAt};
 
 use common::{Rand, scene, two_rooms, unshadowed, value};
 use glam::Vec3;
@@ -170,18 +171,18 @@ fn resampled_estimates_are_unbiased() {
     for _ in 0..3 {
         for _ in 0..8000 {
             let p = rng.point(9.5);
-            let Some(x) = glt.sample(&ShadingContext::at(p), rng.f()) else {
+            let Some(x) = ByPosition(&glt).sample(&ShadingContext::at(p), rng.f()) else {
                 continue;
             };
             let LightId::Emitter(e) = x.light else {
                 continue;
             };
-            glt.splat_at(p, x.light, value(&lights, e, p) / x.pmf);
+            glt.record_light_at(p, x.light, value(&lights, e, p) / x.pmf);
         }
         glt.refine();
     }
     let bvh = ImportanceTreeSampler::new(&tree);
-    let samplers: [(&str, &dyn LightSampler); 2] = [("glt", &glt), ("bvh", &bvh)];
+    let samplers: [(&str, &dyn LightSampler); 2] = [("glt", &ByPosition(&glt)), ("bvh", &bvh)];
     for (i, p) in [Vec3::new(-3.0, 1.0, 2.0), Vec3::new(0.5, -2.0, -1.0)]
         .into_iter()
         .enumerate()

@@ -2,12 +2,15 @@
 //! rules, memory budget and report, bad input, the learned BSDF fraction
 //! and bit-exact concurrency.
 
+mod common;
+use common::DirectionsAt;
 use glam::{Vec2, Vec3};
 use guiding::math::{Aabb, Accumulation, canonical_to_dir};
 use guiding::quadtree::{DirectionalFilter, UNIFORM_PDF};
 use guiding::sd_tree::{SdTree, SdTreeConfig};
 use guiding::spatial::SpatialFilter;
 use guiding::spatial::SpatialTree;
+use guiding::{RecordOutcome, ShadingContext};
 use rand_core::{Rng, SeedableRng};
 use rand_pcg::Pcg32;
 
@@ -46,7 +49,10 @@ fn train(tree: &SdTree, n: usize, seed: u64) {
     for _ in 0..n {
         let p = point_in(&mut rng, &b);
         let d = lobe_dir(&mut rng);
-        assert!(tree.splat(p, d, 1.0, UNIFORM_PDF, &mut rng));
+        assert_ne!(
+            tree.record_radiance_at(p, d, 1.0, UNIFORM_PDF),
+            RecordOutcome::Dropped
+        );
     }
 }
 
@@ -79,7 +85,7 @@ fn pdf_integrates_to_one_in_every_cell() {
         let integral: f64 = leaves
             .iter()
             .map(|l| {
-                t.pdf(p, canonical_to_dir(l.center())) as f64
+                t.direction_pdf_at(p, canonical_to_dir(l.center())) as f64
                     * l.area()
                     * 4.0
                     * core::f64::consts::PI
@@ -94,7 +100,7 @@ fn pdf_integrates_to_one_in_every_cell() {
     for i in 0..n {
         for j in 0..n {
             let c = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
-            sum += t.pdf(p, canonical_to_dir(c)) as f64;
+            sum += t.direction_pdf_at(p, canonical_to_dir(c)) as f64;
         }
     }
     let integral = sum * 4.0 * core::f64::consts::PI / (n * n) as f64;
@@ -108,19 +114,30 @@ fn sampled_pdf_equals_pdf() {
     let b = scene();
     for _ in 0..20_000 {
         let p = point_in(&mut rng, &b);
-        let (dir, pdf) = t.sample(p, [unit(&mut rng), unit(&mut rng)]).unwrap();
+        let (dir, pdf) = t
+            .sample_direction_at(p, [unit(&mut rng), unit(&mut rng)])
+            .unwrap();
         assert!((dir.length() - 1.0).abs() < 1e-5);
         assert!(pdf > 0.0);
-        assert_eq!(pdf, t.pdf(p, dir), "at {p} toward {dir}");
+        assert_eq!(pdf, t.direction_pdf_at(p, dir), "at {p} toward {dir}");
         // Any positive length evaluates the same.
-        assert_eq!(t.pdf(p, dir * 3.0), pdf);
+        assert_eq!(t.direction_pdf_at(p, dir * 3.0), pdf);
     }
-    assert!(t.sample(Vec3::NAN, [0.5, 0.5]).is_none());
-    assert_eq!(t.pdf(Vec3::new(f32::INFINITY, 0.0, 0.0), Vec3::Z), 0.0);
-    assert_eq!(t.pdf(Vec3::ZERO, Vec3::ZERO), 0.0);
-    assert_eq!(t.pdf(Vec3::ZERO, Vec3::new(f32::NAN, 0.0, 1.0)), 0.0);
+    assert!(t.sample_direction_at(Vec3::NAN, [0.5, 0.5]).is_none());
+    assert_eq!(
+        t.direction_pdf_at(Vec3::new(f32::INFINITY, 0.0, 0.0), Vec3::Z),
+        0.0
+    );
+    assert_eq!(t.direction_pdf_at(Vec3::ZERO, Vec3::ZERO), 0.0);
+    assert_eq!(
+        t.direction_pdf_at(Vec3::ZERO, Vec3::new(f32::NAN, 0.0, 1.0)),
+        0.0
+    );
     // Outside the scene: the clamped point's distribution.
-    assert_eq!(t.pdf(Vec3::splat(100.0), Vec3::Z), t.pdf(b.max, Vec3::Z));
+    assert_eq!(
+        t.direction_pdf_at(Vec3::splat(100.0), Vec3::Z),
+        t.direction_pdf_at(b.max, Vec3::Z)
+    );
 }
 
 #[test]
@@ -129,7 +146,7 @@ fn learning_concentrates_on_the_splatted_directions() {
     assert_eq!(t.cell_count(), 1);
     let p = Vec3::ZERO;
     for l in lobes() {
-        let ratio = t.pdf(p, l) / UNIFORM_PDF;
+        let ratio = t.direction_pdf_at(p, l) / UNIFORM_PDF;
         assert!(ratio > 20.0, "lobe {l}: {ratio}");
     }
     // Directions away from every lobe lose density.
@@ -139,7 +156,7 @@ fn learning_concentrates_on_the_splatted_directions() {
     for _ in 0..2000 {
         let d = canonical_to_dir(Vec2::new(unit(&mut rng), unit(&mut rng)));
         if lobes().iter().all(|l| l.dot(d) < 0.7) {
-            away += t.pdf(p, d);
+            away += t.direction_pdf_at(p, d);
             count += 1;
         }
     }
@@ -147,7 +164,9 @@ fn learning_concentrates_on_the_splatted_directions() {
     // Samples go to the lobes.
     let near = (0..2000)
         .filter(|_| {
-            let (d, _) = t.sample(p, [unit(&mut rng), unit(&mut rng)]).unwrap();
+            let (d, _) = t
+                .sample_direction_at(p, [unit(&mut rng), unit(&mut rng)])
+                .unwrap();
             lobes().iter().any(|l| l.dot(d) > 0.95)
         })
         .count();
@@ -155,9 +174,11 @@ fn learning_concentrates_on_the_splatted_directions() {
 }
 
 fn splat_n(t: &SdTree, p: Vec3, n: usize) {
-    let mut rng = Pcg32::seed_from_u64(1);
     for _ in 0..n {
-        assert!(t.splat(p, Vec3::Z, 1.0, 1.0, &mut rng));
+        assert_ne!(
+            t.record_radiance_at(p, Vec3::Z, 1.0, 1.0),
+            RecordOutcome::Dropped
+        );
     }
 }
 
@@ -167,7 +188,13 @@ fn spatial_split_exactly_above_threshold_copies_and_halves() {
     // Iteration 0: threshold c = 100.
     let mut t = SdTree::new(scene(), config(100.0)).unwrap();
     splat_n(&t, p, 100);
-    assert_eq!(t.vertex(p).unwrap().sd().building_weight(), 100.0);
+    assert_eq!(
+        t.vertex(&ShadingContext::at(p))
+            .unwrap()
+            .sd()
+            .building_weight(),
+        100.0
+    );
     assert_eq!(t.refine().splits, 0);
     assert_eq!(t.cell_count(), 1);
     // Iteration 1: threshold 100 sqrt 2 = 141.42.
@@ -266,7 +293,6 @@ fn bad_input_is_dropped_counted_and_never_stored() {
         },
     )
     .unwrap();
-    let mut rng = Pcg32::seed_from_u64(5);
     let p = Vec3::ZERO;
     let d = Vec3::Z;
     let nan = f32::NAN;
@@ -282,60 +308,94 @@ fn bad_input_is_dropped_counted_and_never_stored() {
         Vec3::new(0.0, inf, 1.0),
     ];
     for q in bad_positions {
-        assert!(!t.splat(q, d, 1.0, 1.0, &mut rng));
+        assert!((t.record_radiance_at(q, d, 1.0, 1.0) == RecordOutcome::Dropped));
     }
     for dir in bad_dirs {
-        assert!(!t.splat(p, dir, 1.0, 1.0, &mut rng));
+        assert!((t.record_radiance_at(p, dir, 1.0, 1.0) == RecordOutcome::Dropped));
     }
     for r in [nan, inf, -1.0, -0.0 - f32::MIN_POSITIVE] {
-        assert!(!t.splat(p, d, r, 1.0, &mut rng));
+        assert!((t.record_radiance_at(p, d, r, 1.0) == RecordOutcome::Dropped));
     }
     for pdf in [0.0, -1.0, nan, inf, -0.0] {
-        assert!(!t.splat(p, d, 1.0, pdf, &mut rng));
+        assert!((t.record_radiance_at(p, d, 1.0, pdf) == RecordOutcome::Dropped));
     }
-    assert!(!t.splat(p, d, 1.0e30, 1.0e-30, &mut rng));
+    assert!((t.record_radiance_at(p, d, 1.0e30, 1.0e-30) == RecordOutcome::Dropped));
     // Every filter drops the same way.
     for f in [SpatialFilter::Box, SpatialFilter::StochasticBox] {
-        assert!(!t.splat_filtered(p, d, nan, 1.0, f, DirectionalFilter::Box, &mut rng));
+        let filtered = SdTreeConfig {
+            spatial_filter: f,
+            directional_filter: DirectionalFilter::Box,
+            ..config(1.0)
+        };
+        let other = SdTree::new(scene(), filtered).unwrap();
+        assert_eq!(
+            other.record_radiance_at(p, d, nan, 1.0),
+            RecordOutcome::Dropped
+        );
+        assert_eq!(other.dropped_records().radiance, 1);
     }
     // Fraction records.
-    assert!(!t.record_fraction(Vec3::NAN, 1.0, 1.0, 1.0));
-    assert!(!t.record_fraction(p, 1.0, 1.0, -1.0));
-    assert!(!t.record_fraction(p, 0.0, 0.0, 1.0));
-    assert!(!t.record_fraction(p, nan, 1.0, 1.0));
-    let dropped = t.dropped_splats();
+    assert!((t.record_fraction_at(Vec3::NAN, 1.0, 1.0, 1.0) == RecordOutcome::Dropped));
+    assert!((t.record_fraction_at(p, 1.0, 1.0, -1.0) == RecordOutcome::Dropped));
+    assert!((t.record_fraction_at(p, 0.0, 0.0, 1.0) == RecordOutcome::Dropped));
+    assert!((t.record_fraction_at(p, nan, 1.0, 1.0) == RecordOutcome::Dropped));
+    let dropped = t.dropped_records();
     assert_eq!(dropped.position, 3 + 1);
     assert_eq!(dropped.direction, 3);
-    assert_eq!(dropped.radiance, 4 + 2 + 1);
+    assert_eq!(dropped.radiance, 4 + 1);
     assert_eq!(dropped.pdf, 5 + 2);
     assert_eq!(dropped.overflow, 1);
-    assert_eq!(dropped.total(), 4 + 3 + 7 + 7 + 1);
+    assert_eq!(dropped.total(), 4 + 3 + 5 + 7 + 1);
     // Nothing was stored: no weight, nothing learned, no split, fraction
     // unchanged.
-    assert_eq!(t.vertex(p).unwrap().sd().building_weight(), 0.0);
+    assert_eq!(
+        t.vertex(&ShadingContext::at(p))
+            .unwrap()
+            .sd()
+            .building_weight(),
+        0.0
+    );
     t.refine();
     assert_eq!(t.cell_count(), 1);
-    assert_eq!(t.pdf(p, Vec3::X), UNIFORM_PDF);
-    assert_eq!(t.bsdf_fraction(p), 0.5);
+    assert_eq!(t.direction_pdf_at(p, Vec3::X), UNIFORM_PDF);
+    assert_eq!(t.bsdf_fraction_at(p), 0.5);
     // Valid zero radiance counts weight, no power.
-    assert!(t.splat(p, d, 0.0, 1.0, &mut rng));
-    assert_eq!(t.vertex(p).unwrap().sd().building_weight(), 1.0);
-    t.reset_dropped_splats();
-    assert_eq!(t.dropped_splats().total(), 0);
-    // Learning disabled: records are refused but not counted.
+    assert_ne!(t.record_radiance_at(p, d, 0.0, 1.0), RecordOutcome::Dropped);
+    assert_eq!(
+        t.vertex(&ShadingContext::at(p))
+            .unwrap()
+            .sd()
+            .building_weight(),
+        1.0
+    );
+    t.reset_dropped_records();
+    assert_eq!(t.dropped_records().total(), 0);
+    // Learning disabled: valid records are ignored, not counted.
     let off = SdTree::new(scene(), config(1.0)).unwrap();
-    assert!(!off.record_fraction(p, 1.0, 1.0, 1.0));
-    assert_eq!(off.dropped_splats().total(), 0);
+    assert_eq!(
+        off.record_fraction_at(p, 1.0, 1.0, 1.0),
+        RecordOutcome::Ignored
+    );
+    assert_eq!(off.dropped_records().total(), 0);
 }
 
 #[test]
 fn box_filters_spread_weight_by_overlap() {
-    let mut t = SdTree::new(scene(), config(10.0)).unwrap();
-    // Four cells: split along x, then y, at the origin.
-    splat_n(&t, Vec3::ZERO, 40);
-    assert_eq!(t.refine().splits, 3);
-    assert_eq!(t.cell_count(), 4);
-    let mut rng = Pcg32::seed_from_u64(2);
+    // Four cells: split along x, then y, at the origin (with one cell
+    // every filter records the same).
+    let four_cells = |spatial_filter| {
+        let filtered = SdTreeConfig {
+            spatial_filter,
+            directional_filter: DirectionalFilter::Nearest,
+            ..config(10.0)
+        };
+        let mut t = SdTree::new(scene(), filtered).unwrap();
+        splat_n(&t, Vec3::ZERO, 40);
+        assert_eq!(t.refine().splits, 3);
+        assert_eq!(t.cell_count(), 4);
+        t
+    };
+    let t = four_cells(SpatialFilter::Box);
     // Each cell gets the fraction of the cell-sized box around p it covers.
     let tree = t.spatial();
     let b = tree.root_bounds();
@@ -351,15 +411,10 @@ fn box_filters_spread_weight_by_overlap() {
             d.x as f64 * d.y as f64 * d.z as f64
         }
     };
-    assert!(t.splat_filtered(
-        p,
-        Vec3::Z,
-        1.0,
-        1.0,
-        SpatialFilter::Box,
-        DirectionalFilter::Nearest,
-        &mut rng
-    ));
+    assert_eq!(
+        t.record_radiance_at(p, Vec3::Z, 1.0, 1.0),
+        RecordOutcome::Recorded
+    );
     let mut touched = 0;
     let expected: Vec<f64> = tree
         .cells()
@@ -373,15 +428,10 @@ fn box_filters_spread_weight_by_overlap() {
     }
     assert!(touched >= 2);
     // At the scene border the box is clipped, so nothing is lost.
-    assert!(t.splat_filtered(
-        b.min,
-        Vec3::Z,
-        1.0,
-        1.0,
-        SpatialFilter::Box,
-        DirectionalFilter::Nearest,
-        &mut rng
-    ));
+    assert_eq!(
+        t.record_radiance_at(b.min, Vec3::Z, 1.0, 1.0),
+        RecordOutcome::Recorded
+    );
     let total: f64 = t
         .spatial()
         .data_slice()
@@ -390,7 +440,11 @@ fn box_filters_spread_weight_by_overlap() {
         .sum();
     assert!((total - 2.0).abs() < 1e-6, "{total}");
 
-    // Stochastic box: the same weights in expectation, one cell per splat.
+    // Stochastic box: the same weights in expectation, one cell per
+    // record. Its offset is a hash of the record, so these records at one
+    // point differ in their direction (at one point along one direction
+    // every record would go to the same cell).
+    let t = four_cells(SpatialFilter::StochasticBox);
     let before: Vec<f64> = t
         .spatial()
         .data_slice()
@@ -398,16 +452,12 @@ fn box_filters_spread_weight_by_overlap() {
         .map(|c| c.building_weight())
         .collect();
     let n = 4000.0;
-    for _ in 0..n as usize {
-        assert!(t.splat_filtered(
-            p,
-            Vec3::Z,
-            1.0,
-            1.0,
-            SpatialFilter::StochasticBox,
-            DirectionalFilter::Nearest,
-            &mut rng
-        ));
+    for i in 0..n as usize {
+        let dir = Vec3::new(i as f32 * 1e-4, 0.0, 1.0);
+        assert_eq!(
+            t.record_radiance_at(p, dir, 1.0, 1.0),
+            RecordOutcome::Recorded
+        );
     }
     let gained: Vec<f64> = t
         .spatial()
@@ -444,9 +494,9 @@ fn learned_fraction_moves_toward_the_better_technique() {
         .unwrap();
         let mut rng = Pcg32::seed_from_u64(seed);
         let p = Vec3::ZERO;
-        let mut history = vec![t.bsdf_fraction(p)];
+        let mut history = vec![t.bsdf_fraction_at(p)];
         for _ in 0..6 {
-            let s = t.bsdf_fraction(p);
+            let s = t.bsdf_fraction_at(p);
             for _ in 0..2000 {
                 let pick_bsdf = unit(&mut rng) < s;
                 let u = unit(&mut rng).max(1e-7);
@@ -455,12 +505,15 @@ fn learned_fraction_moves_toward_the_better_technique() {
                 let (pg, pu) = (2.0 * x, 1.0);
                 let (pb, pguide) = if bsdf_is_good { (pg, pu) } else { (pu, pg) };
                 let q = s * pb + (1.0 - s) * pguide;
-                assert!(t.record_fraction(p, pb, pguide, 2.0 * x / q));
+                assert_ne!(
+                    t.record_fraction_at(p, pb, pguide, 2.0 * x / q),
+                    RecordOutcome::Dropped
+                );
             }
             // Fixed during the iteration.
-            assert_eq!(t.bsdf_fraction(p), s);
+            assert_eq!(t.bsdf_fraction_at(p), s);
             t.refine();
-            history.push(t.bsdf_fraction(p));
+            history.push(t.bsdf_fraction_at(p));
         }
         history
     }
@@ -480,20 +533,19 @@ fn learned_fraction_moves_toward_the_better_technique() {
     )
     .unwrap();
     fixed.refine();
-    assert_eq!(fixed.bsdf_fraction(Vec3::ZERO), 0.3);
-    let m = fixed.mixture_pdf(Vec3::ZERO, Vec3::Z, 2.0);
+    assert_eq!(fixed.bsdf_fraction_at(Vec3::ZERO), 0.3);
+    let m = fixed.mixture_pdf_at(Vec3::ZERO, Vec3::Z, 2.0);
     assert!((m - (0.3 * 2.0 + 0.7 * UNIFORM_PDF)).abs() < 1e-6);
 }
 
-/// One training input: position, direction, radiance, pdf, RNG seed, and a
-/// fraction record.
+/// One training input: position, direction, radiance, pdf and a fraction
+/// record.
 #[derive(Clone, Copy)]
 struct Input {
     p: Vec3,
     dir: Vec3,
     radiance: f32,
     pdf: f32,
-    seed: u64,
     fraction: (f32, f32, f32),
 }
 
@@ -501,22 +553,26 @@ fn inputs(n: usize, seed: u64) -> Vec<Input> {
     let mut rng = Pcg32::seed_from_u64(seed);
     let b = scene();
     (0..n)
-        .map(|i| Input {
+        .map(|_| Input {
             p: point_in(&mut rng, &b),
             dir: lobe_dir(&mut rng),
             radiance: -(1.0 - unit(&mut rng)).ln() * 3.0,
             pdf: 0.05 + 2.0 * unit(&mut rng),
-            seed: i as u64 ^ seed << 32,
             fraction: (unit(&mut rng) * 2.0, unit(&mut rng) * 2.0, unit(&mut rng)),
         })
         .collect()
 }
 
 fn apply(t: &SdTree, input: &Input) {
-    let mut rng = Pcg32::seed_from_u64(input.seed);
-    assert!(t.splat(input.p, input.dir, input.radiance, input.pdf, &mut rng));
+    assert_ne!(
+        t.record_radiance_at(input.p, input.dir, input.radiance, input.pdf),
+        RecordOutcome::Dropped
+    );
     let (pb, pg, c) = input.fraction;
-    assert!(t.record_fraction(input.p, pb, pg, c));
+    assert_ne!(
+        t.record_fraction_at(input.p, pb, pg, c),
+        RecordOutcome::Dropped
+    );
 }
 
 /// Feeds a batch with `threads` threads (0 = the calling thread, in

@@ -4,6 +4,8 @@
 //! in the middle of a render keep every contract.
 
 mod common;
+use common::ByPosition;
+use common::LightsAt;
 
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
@@ -44,7 +46,7 @@ fn refining_from_a_worker_equals_serial() {
     let mut serial = Glt::new(&tree, scene(), config()).unwrap();
     for round in &rounds {
         for &(p, e, v) in *round {
-            serial.splat_at(p, LightId::Emitter(e), v);
+            serial.record_light_at(p, LightId::Emitter(e), v);
         }
         serial.refine();
     }
@@ -59,7 +61,7 @@ fn refining_from_a_worker_equals_serial() {
                     for tile in round.chunks(100).skip(t).step_by(4) {
                         let glt = shared.read();
                         for &(p, e, v) in tile {
-                            glt.splat_at(p, LightId::Emitter(e), v);
+                            glt.record_light_at(p, LightId::Emitter(e), v);
                         }
                     }
                     if barrier.wait().is_leader() {
@@ -126,11 +128,13 @@ fn refinements_in_the_middle_of_a_render_keep_the_contracts() {
                         let glt = shared.read();
                         for _ in 0..50 {
                             let p = rng.point(9.5);
-                            let x = glt.sample(&ShadingContext::at(p), rng.f()).unwrap();
+                            let x = ByPosition(&*glt)
+                                .sample(&ShadingContext::at(p), rng.f())
+                                .unwrap();
                             let LightId::Emitter(e) = x.light else {
                                 panic!("no unbounded lights")
                             };
-                            glt.splat(p, x.light, value(lights, e, p) / x.pmf, &mut rng.0);
+                            glt.record_light_at(p, x.light, value(lights, e, p) / x.pmf);
                         }
                     }
                     match t {
@@ -155,10 +159,10 @@ fn refinements_in_the_middle_of_a_render_keep_the_contracts() {
     for _ in 0..50 {
         let ctx = ShadingContext::at(rng.point(9.0));
         let total: f64 = (0..80)
-            .map(|e| glt.pmf_exact(&ctx, LightId::Emitter(e)))
+            .map(|e| ByPosition(&*glt).pmf_exact(&ctx, LightId::Emitter(e)))
             .sum();
         assert!((total - 1.0).abs() < 1e-6);
-        let x = glt.sample(&ctx, rng.f()).unwrap();
-        assert_eq!(x.pmf, glt.pmf(&ctx, x.light));
+        let x = ByPosition(&*glt).sample(&ctx, rng.f()).unwrap();
+        assert_eq!(x.pmf, ByPosition(&*glt).pmf(&ctx, x.light));
     }
 }

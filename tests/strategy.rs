@@ -2,6 +2,7 @@
 //! tree, and reports unknown names and unbuildable emitters as errors.
 
 mod common;
+use common::{ByPosition, LightsAt};
 
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
@@ -20,11 +21,12 @@ fn each_name_is_its_sampler() {
     assert_send_sync::<Strategy>();
     let lights = two_rooms();
     let tree = LightTree::build(&lights, BuildHeuristic::default()).unwrap();
-    let direct: [Box<dyn LightSampler>; 4] = [
+    let glt = Glt::new(&tree, scene(), GltConfig::default()).unwrap();
+    let direct: [Box<dyn LightSampler + '_>; 4] = [
         Box::new(UniformSampler::new(lights.len())),
         Box::new(PowerSampler::new(&lights[..])),
         Box::new(ImportanceTreeSampler::new(&tree)),
-        Box::new(Glt::new(&tree, scene(), GltConfig::default()).unwrap()),
+        Box::new(ByPosition(&glt)),
     ];
     let mut rng = Rand::new(3);
     for (name, reference) in Strategy::NAMES.iter().zip(&direct) {
@@ -58,11 +60,12 @@ fn each_name_takes_unbounded_lights() {
         |s| -> Box<dyn LightSampler> { Box::new(WithUnbounded::new(s, sun_and_sky).unwrap()) };
     let mut config = GltConfig::default();
     config.cut.unbounded = sun_and_sky;
-    let direct: [Box<dyn LightSampler>; 4] = [
+    let glt = Glt::new(&tree, scene(), config).unwrap();
+    let direct: [Box<dyn LightSampler + '_>; 4] = [
         Box::new(WithUnbounded::new(UniformSampler::new(lights.len()), sun_and_sky).unwrap()),
         Box::new(WithUnbounded::new(PowerSampler::new(&lights[..]), sun_and_sky).unwrap()),
         with(ImportanceTreeSampler::new(&tree)),
-        Box::new(Glt::new(&tree, scene(), config).unwrap()),
+        Box::new(ByPosition(&glt)),
     ];
     let mut rng = Rand::new(4);
     for (name, reference) in Strategy::NAMES.iter().zip(&direct) {
@@ -112,11 +115,13 @@ fn the_glt_strategy_trains() {
         let glt = s.glt_mut().unwrap();
         for _ in 0..40000 {
             let p = rng.point(9.5);
-            let x = glt.sample(&ShadingContext::at(p), rng.f()).unwrap();
+            let x = ByPosition(&*glt)
+                .sample(&ShadingContext::at(p), rng.f())
+                .unwrap();
             let LightId::Emitter(e) = x.light else {
                 panic!()
             };
-            glt.splat(p, x.light, value(&lights, e, p) / x.pmf, &mut rng.0);
+            glt.record_light_at(p, x.light, value(&lights, e, p) / x.pmf);
         }
         glt.refine();
     }

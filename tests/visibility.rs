@@ -6,10 +6,12 @@
 //! beats a blind target.
 
 mod common;
+use common::{ByPosition, LightsAt};
+use guiding::RecordOutcome;
 
 use common::{Rand, scene, two_rooms, unshadowed, value};
 use glam::Vec3;
-use guiding::glt::{CutConfig, Glt, GltConfig, SplatOutcome};
+use guiding::glt::{CutConfig, Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::resampling::{Evaluated, resample};
 use guiding::{LightId, LightSampler, LightTree, ShadingContext};
@@ -39,15 +41,15 @@ fn trained(visibility: bool) -> Glt<&'static LightTree> {
     for _ in 0..3 {
         for _ in 0..8000 {
             let p = rng.point(9.5);
-            let Some(x) = glt.sample(&ShadingContext::at(p), rng.f()) else {
+            let Some(x) = ByPosition(&glt).sample(&ShadingContext::at(p), rng.f()) else {
                 continue;
             };
             let LightId::Emitter(e) = x.light else {
                 continue;
             };
             let seen = value(&lights, e, p) / x.pmf;
-            glt.splat_at(p, x.light, seen);
-            glt.splat_visibility(p, x.light, seen, unshadowed(&lights, e, p) / x.pmf);
+            glt.record_light_at(p, x.light, seen);
+            glt.record_visibility_at(p, x.light, seen, unshadowed(&lights, e, p) / x.pmf);
         }
         glt.refine();
     }
@@ -76,13 +78,13 @@ fn room_visibility(glt: &impl LightSampler, p: Vec3) -> (f32, f32) {
 fn each_room_learns_the_other_is_hidden() {
     let glt = trained(true);
     for p in [Vec3::new(-5.0, 1.0, 2.0), Vec3::new(6.0, -3.0, -1.0)] {
-        let (own, other) = room_visibility(&glt, p);
+        let (own, other) = room_visibility(&ByPosition(&glt), p);
         assert!(
             own > 0.8 && other < 0.2,
             "at {p}: own room {own}, other {other}"
         );
         // The vertex answers as the GLT by position.
-        let v = glt.vertex(p).unwrap();
+        let v = glt.vertex(&ShadingContext::at(p)).unwrap();
         assert_eq!(room_visibility(&v, p), (own, other));
     }
 }
@@ -90,11 +92,11 @@ fn each_room_learns_the_other_is_hidden() {
 #[test]
 fn off_by_default() {
     let glt = trained(false);
-    let (own, other) = room_visibility(&glt, Vec3::new(-5.0, 1.0, 2.0));
+    let (own, other) = room_visibility(&ByPosition(&glt), Vec3::new(-5.0, 1.0, 2.0));
     assert_eq!((own, other), (1.0, 1.0));
     assert_eq!(
-        glt.splat_visibility(Vec3::ZERO, LightId::Emitter(0), 0.5, 1.0),
-        SplatOutcome::Zero
+        glt.record_visibility_at(Vec3::ZERO, LightId::Emitter(0), 0.5, 1.0),
+        RecordOutcome::Ignored
     );
     // It costs nothing: 20 bytes per slot only when on.
     let (off, on) = (trained(false).memory(), trained(true).memory());
@@ -114,20 +116,23 @@ fn bad_records_are_dropped_and_counted() {
         (LightId::Unbounded(0), 0.5, 1.0),
     ];
     for (i, (light, s, u)) in bad.into_iter().enumerate() {
-        assert_eq!(glt.splat_visibility(p, light, s, u), SplatOutcome::Dropped);
-        assert_eq!(glt.dropped_splats().light, i as u64 + 1);
+        assert_eq!(
+            glt.record_visibility_at(p, light, s, u),
+            RecordOutcome::Dropped
+        );
+        assert_eq!(glt.dropped_records().light, i as u64 + 1);
     }
     assert_eq!(
-        glt.splat_visibility(Vec3::NAN, LightId::Emitter(0), 0.5, 1.0),
-        SplatOutcome::Dropped
+        glt.record_visibility_at(Vec3::NAN, LightId::Emitter(0), 0.5, 1.0),
+        RecordOutcome::Dropped
     );
     assert_eq!(
-        glt.splat_visibility(p, LightId::Emitter(0), 0.0, 0.0),
-        SplatOutcome::Zero
+        glt.record_visibility_at(p, LightId::Emitter(0), 0.0, 0.0),
+        RecordOutcome::Zero
     );
     assert_eq!(
-        glt.splat_visibility(p, LightId::Emitter(0), 0.5, 1.0),
-        SplatOutcome::Recorded
+        glt.record_visibility_at(p, LightId::Emitter(0), 0.5, 1.0),
+        RecordOutcome::Recorded
     );
 }
 
@@ -141,7 +146,7 @@ fn visibility_survives_saving_loading_and_merging() {
     // Pending records, not yet refined.
     let p = Vec3::new(-4.0, 0.0, 0.0);
     for e in 0..80 {
-        glt.splat_visibility(
+        glt.record_visibility_at(
             p,
             LightId::Emitter(e),
             value(&lights, e, p),
@@ -157,7 +162,10 @@ fn visibility_survives_saving_loading_and_merging() {
     let mut b = Glt::from_bytes(&bytes, tree()).unwrap();
     b.refine();
     let q = Vec3::new(-5.0, 1.0, 2.0);
-    assert_eq!(room_visibility(&a, q), room_visibility(&b, q));
+    assert_eq!(
+        room_visibility(&ByPosition(&a), q),
+        room_visibility(&ByPosition(&b), q)
+    );
 }
 
 /// Resampling from the trained GLT with its learned visibility (applied by
@@ -201,8 +209,8 @@ fn resampling_with_learned_visibility_is_unbiased_and_better() {
         let var = s2 / n as f64 - mean * mean;
         (mean, (var / n as f64).sqrt(), var)
     };
-    let (m1, se1, v1) = run(&seeing);
-    let (m0, se0, v0) = run(&blind);
+    let (m1, se1, v1) = run(&ByPosition(&seeing));
+    let (m0, se0, v0) = run(&ByPosition(&blind));
     assert!((m1 - truth).abs() < 4.5 * se1, "{m1} +- {se1} vs {truth}");
     assert!((m0 - truth).abs() < 4.5 * se0, "{m0} +- {se0} vs {truth}");
     assert!(v1 < 0.8 * v0, "learned visibility {v1}, blind {v0}");
@@ -227,7 +235,7 @@ fn sampling_with_visibility_equals_sampling_then_visibility() {
         for _ in 0..3 {
             for _ in 0..8000 {
                 let p = rng.point(9.5);
-                let Some(x) = glt.sample(&ShadingContext::at(p), rng.f()) else {
+                let Some(x) = ByPosition(&glt).sample(&ShadingContext::at(p), rng.f()) else {
                     continue;
                 };
                 let (seen, open) = match x.light {
@@ -235,8 +243,8 @@ fn sampling_with_visibility_equals_sampling_then_visibility() {
                     // The first unbounded light is hidden half the time.
                     LightId::Unbounded(i) => (if i == 0 && rng.f() < 0.5 { 0.0 } else { 1.0 }, 1.0),
                 };
-                glt.splat_at(p, x.light, seen / x.pmf);
-                glt.splat_visibility(p, x.light, seen / x.pmf, open / x.pmf);
+                glt.record_light_at(p, x.light, seen / x.pmf);
+                glt.record_visibility_at(p, x.light, seen / x.pmf, open / x.pmf);
             }
             glt.refine();
         }
@@ -245,8 +253,8 @@ fn sampling_with_visibility_equals_sampling_then_visibility() {
             let p = rng.point(9.5);
             let ctx = ShadingContext::on_surface(p, Vec3::Y);
             let u = rng.f();
-            let vertex = glt.vertex(p).unwrap();
-            let samplers: [&dyn LightSampler; 2] = [&glt, &vertex];
+            let vertex = glt.vertex(&ShadingContext::at(p)).unwrap();
+            let samplers: [&dyn LightSampler; 2] = [&ByPosition(&glt), &vertex];
             for s in samplers {
                 let want = s.sample(&ctx, u).map(|x| (x, s.visibility(&ctx, x.light)));
                 let got = s.sample_with_visibility(&ctx, u);
@@ -284,7 +292,10 @@ fn the_learned_visibility_is_the_shrunk_ratio() {
     let round = |records: &[(f32, f32)], cut: &mut guiding::glt::GuidingCut| {
         guide.splat(cut, l, 1.0);
         for &(s, u) in records {
-            assert_eq!(guide.splat_visibility(cut, l, s, u), SplatOutcome::Recorded);
+            assert_eq!(
+                guide.splat_visibility(cut, l, s, u),
+                RecordOutcome::Recorded
+            );
         }
         guide.refine(cut);
         cut.visibility().to_vec()

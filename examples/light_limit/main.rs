@@ -318,7 +318,7 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
         };
         let (_, trained) = run::render_trained(&scene, Method::PtGlt, &settings);
         let glt = trained.glt.ok_or("pt-glt trains a GLT")?;
-        let (v, vb) = pmfs_of(&points, |ctx, l| f64::from(glt.pmf(ctx, l)));
+        let (v, vb) = pmfs_of(&points, |ctx, l| f64::from(pmf_at(&glt, ctx, l)));
         if args.breakdown {
             let pmf_vectors =
                 |f: &(dyn Fn(&ShadingContext, LightId) -> f64 + Sync)| -> Vec<Vec<f64>> {
@@ -330,7 +330,7 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
                         })
                         .collect()
                 };
-            let pmfs = pmf_vectors(&|ctx, l| f64::from(glt.pmf(ctx, l)));
+            let pmfs = pmf_vectors(&|ctx, l| f64::from(pmf_at(&glt, ctx, l)));
             let bvh = methods::fixed_sampler(&scene, Method::PtBvh).ok_or("bvh")?;
             let prior = pmf_vectors(&|ctx, l| f64::from(bvh.pmf(ctx, l)));
             let clair: Vec<f64> = points
@@ -359,7 +359,7 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
             let pmfs: Vec<f64> = t
                 .lights
                 .iter()
-                .map(|l| f64::from(glt.pmf(&ctx, l.light)))
+                .map(|l| f64::from(pmf_at(&glt, &ctx, l.light)))
                 .collect();
             (ctx, pmfs)
         };
@@ -369,7 +369,10 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
                 Target::Learned(e) => t
                     .lights
                     .iter()
-                    .map(|l| f64::from(glt.visibility(ctx, l.light)).powf(e))
+                    .map(|l| {
+                        let v = glt.vertex(ctx).map_or(1.0, |v| v.visibility(ctx, l.light));
+                        f64::from(v).powf(e)
+                    })
                     .collect(),
                 k => variance::visibilities(t, k == Target::Oracle, 0.05),
             }
@@ -570,4 +573,14 @@ fn to_json(records: &[Record]) -> String {
         })
         .collect();
     format!("[\n{}\n]\n", items.join(",\n"))
+}
+
+/// The GLT's pmf of `light` at `ctx`, through the vertex there (0 where
+/// there is none).
+fn pmf_at(
+    glt: &guiding::glt::Glt<&guiding::LightTree>,
+    ctx: &ShadingContext,
+    light: LightId,
+) -> f32 {
+    glt.vertex(ctx).map_or(0.0, |v| v.pmf(ctx, light))
 }

@@ -1,10 +1,10 @@
 //! The path tracer: next-event estimation from a `guiding::LightSampler`,
 //! MIS-combined (power heuristic) with BSDF sampling or, for the guided
 //! methods, with PPG's one-sample mixture of BSDF and guided sampling
-//! (from an SD-tree cell or a combined-field vertex). While training it
-//! splats direct-light estimates into the GLT (or the field's cuts) and,
-//! once a path is done, incident radiance into the SD-tree (or the field's
-//! quadtrees).
+//! (from an SD-tree's or the combined field's direction vertex). While
+//! training it records direct-light estimates through the GLT's (or the
+//! field's) light vertex and, once a path is done, incident radiance
+//! through the direction vertices (the SD-tree's or the field's).
 
 use crate::bvh::Hit;
 use crate::geometry::{NO_EMITTER, offset_origin};
@@ -12,27 +12,28 @@ use crate::lights::luminance;
 use crate::rng::Sampler;
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
-use guiding::field::{FieldVertex, GuidingField};
+use guiding::field::GuidingField;
 use guiding::glt::Glt;
 use guiding::mis::Convention;
-use guiding::path_recorder::{RadianceRecords, Segment};
 use guiding::resampling::{Evaluated, resample};
-use guiding::sd_tree::{SdCell, SdTree};
-use guiding::spatial::Jitter;
-use guiding::{LightId, LightSampler, LightTree, PathRecorder, ShadingContext};
+use guiding::sd_tree::SdTree;
+use guiding::{
+    DirectionVertex, LightId, LightSampler, LightTree, LightVertex, PathRecorder, ShadingContext,
+};
 
 /// What a path consults and trains.
 #[derive(Clone, Copy)]
 pub struct Guides<'a> {
-    /// Chooses lights for next-event estimation.
-    pub lights: &'a (dyn LightSampler + Sync),
-    /// The Guiding Light Tree to splat direct-light estimates into (the same
-    /// object as `lights` for GLT methods).
+    /// Chooses lights for next-event estimation, for methods that learn no
+    /// light choice (the others choose through the GLT's or the field's
+    /// light vertex).
+    pub lights: Option<&'a (dyn LightSampler + Sync)>,
+    /// The Guiding Light Tree that chooses lights and learns (`pt-glt`).
     pub glt: Option<&'a Glt<&'a LightTree>>,
     /// The SD-tree that guides directions (`ppg`).
     pub sd_tree: Option<&'a SdTree>,
     /// The combined field (`ppg-glt`): guides directions and NEE with one
-    /// lookup per vertex (the same object as `lights`).
+    /// lookup per vertex.
     pub field: Option<&'a GuidingField<&'a LightTree>>,
     /// Whether to record training data this pass.
     pub train: bool,
@@ -57,36 +58,18 @@ pub struct Guides<'a> {
 /// The most candidates a resampled light choice draws.
 pub const MAX_CANDIDATES: usize = 64;
 
-/// The field's cell at a path vertex (`ppg-glt`): found once, it serves
-/// the vertex's queries and every record made there later.
-type Located<'a> = FieldVertex<'a, &'a LightTree>;
+/// A path vertex's learned light choice: the GLT's or the field's cell.
+type Lights<'a> = LightVertex<'a, &'a LightTree>;
 
-/// The recorder of a path's segments, each with the field vertex it was
-/// located in (`None` for `ppg`'s SD-tree, which locates again).
-pub type Recorder<'a> = PathRecorder<Option<Located<'a>>>;
-
-/// Where the recorder's segments go: the SD-tree, or the field through the
-/// vertex each segment kept.
-impl<'a> RadianceRecords<Option<Located<'a>>> for Guides<'a> {
-    fn record<J: Jitter + ?Sized>(
-        &self,
-        seg: &Segment<Option<Located<'a>>>,
-        radiance: f32,
-        contribution: f32,
-        jitter: &mut J,
-    ) {
-        if let Some(t) = self.sd_tree {
-            t.record(&seg.with_cell(()), radiance, contribution, jitter);
-        } else if let (Some(field), Some(v)) = (self.field, seg.cell) {
-            field.record(&seg.with_cell(v), radiance, contribution, jitter);
-        }
-    }
-}
+/// The recorder of a path's segments, each with the direction vertex it
+/// records into.
+pub type Recorder<'a> = PathRecorder<'a>;
 
 /// The last scattering vertex, for MIS at the next emitter hit.
 #[derive(Clone, Copy)]
 struct Vertex<'a> {
-    at: Option<Located<'a>>,
+    /// The learned light choice here, which later records go to.
+    light: Option<Lights<'a>>,
     pos: Vec3,
     normal: Vec3,
     pdf_dir: f32,
@@ -98,69 +81,6 @@ struct Vertex<'a> {
     resampled: bool,
     /// Light samples next-event estimation took here (MIS counts them).
     nee: u32,
-}
-
-/// Directional guiding at one vertex: an SD-tree cell or a field vertex.
-#[derive(Clone, Copy)]
-enum DirGuide<'a> {
-    Sd(&'a SdCell),
-    Field(FieldVertex<'a, &'a LightTree>),
-}
-
-impl DirGuide<'_> {
-    /// Probability of sampling the BSDF rather than the guide.
-    #[inline]
-    fn fraction(&self) -> f32 {
-        match self {
-            Self::Sd(c) => c.bsdf_fraction(),
-            Self::Field(v) => v.bsdf_fraction(),
-        }
-    }
-
-    /// The guide's solid-angle pdf of `dir`.
-    #[inline]
-    fn pdf(&self, dir: Vec3) -> f32 {
-        match self {
-            Self::Sd(c) => c.directions().pdf(dir),
-            Self::Field(v) => v.direction_pdf(dir),
-        }
-    }
-
-    /// A direction from the guide.
-    #[inline]
-    fn sample(&self, u: [f32; 2]) -> Vec3 {
-        match self {
-            Self::Sd(c) => c.directions().sample(u).0,
-            Self::Field(v) => v.sample_direction(u).0,
-        }
-    }
-}
-
-/// Records a direct-light estimate for `light` seen from `v` (the GLT's
-/// splat), into the GLT or the field (through the vertex's located cell).
-#[inline]
-fn splat_light(guides: &Guides, v: &Vertex, light: LightId, value: f32, s: &mut Sampler) {
-    if let Some(glt) = guides.glt {
-        glt.splat(v.pos, light, value, s.rng());
-    } else if let Some(at) = &v.at {
-        at.splat_light(light, value, s.rng());
-    } else if let Some(field) = guides.field {
-        field.splat_light(v.pos, light, value, s.rng());
-    }
-}
-
-/// Records what a next-event sample of `light` from `v` saw, for the
-/// cuts' learned visibility: the value it recorded (0 when blocked) and
-/// the value it would have recorded unoccluded.
-#[inline]
-fn splat_visibility(guides: &Guides, v: &Vertex, light: LightId, seen: f32, unshadowed: f32) {
-    if let Some(glt) = guides.glt {
-        glt.splat_visibility(v.pos, light, seen, unshadowed);
-    } else if let Some(at) = &v.at {
-        at.splat_visibility(light, seen, unshadowed);
-    } else if let Some(field) = guides.field {
-        field.splat_visibility(v.pos, light, seen, unshadowed);
-    }
 }
 
 /// The scalar a light splat starts from: the luminance of the arriving
@@ -186,23 +106,23 @@ fn found_light(
     pdf_light: impl Fn(&Vertex) -> f32,
     le: Vec3,
     recorder: &mut Recorder,
-    s: &mut Sampler,
 ) {
     let Some(v) = prev.filter(|v| !v.delta) else {
         recorder.add_radiance(le);
         return;
     };
     // The light strategy took `v.nee` samples at `v`.
-    let pmf = guides
-        .lights
-        .pmf(&ShadingContext::on_surface(v.pos, v.normal), id)
-        * v.nee as f32;
+    let ctx = ShadingContext::on_surface(v.pos, v.normal);
+    let pmf = match (&v.light, guides.lights) {
+        (Some(l), _) => l.pmf(&ctx, id),
+        (None, Some(fixed)) => fixed.pmf(&ctx, id),
+        (None, None) => 0.0,
+    } * v.nee as f32;
     let d = Convention::PbrtV4.bsdf_sample(pmf, pdf_light(&v), v.pdf_dir);
     recorder.add_radiance(le * d.weight);
-    let train = guides.train && (guides.glt.is_some() || guides.field.is_some());
     let value = splat_value(guides, v.f_cos, le) * d.factor;
-    if train && value > 0.0 {
-        splat_light(guides, &v, id, value, s);
+    if let Some(l) = v.light.filter(|_| guides.train && value > 0.0) {
+        l.record_light(id, value);
     }
 }
 
@@ -239,7 +159,7 @@ pub fn radiance<'a>(
             // The sky (the sun is a delta light: no BSDF sample finds it).
             if let Some((id, sky)) = scene.sky().filter(|_| !counted) {
                 let pdf_light = |v: &Vertex| sky.pdf(v.normal, dir);
-                found_light(guides, prev, id, pdf_light, sky.radiance, recorder, s);
+                found_light(guides, prev, id, pdf_light, sky.radiance, recorder);
             }
             break;
         };
@@ -255,7 +175,7 @@ pub fn radiance<'a>(
             if le.max_element() > 0.0 {
                 let id = LightId::Emitter(prim.emitter);
                 let pdf_light = |v: &Vertex| light.pdf(v.pos, dir, (p - v.pos).length(), ng);
-                found_light(guides, prev, id, pdf_light, le, recorder, s);
+                found_light(guides, prev, id, pdf_light, le, recorder);
             }
         }
         let mat = scene.materials[prim.material as usize];
@@ -269,7 +189,7 @@ pub fn radiance<'a>(
             };
             recorder.scatter_unrecorded(bs.weight);
             prev = Some(Vertex {
-                at: None,
+                light: None,
                 pos: p,
                 normal: ng,
                 pdf_dir: 0.0,
@@ -285,7 +205,19 @@ pub fn radiance<'a>(
         specular_chain = false;
         let n = if ng.dot(wo) < 0.0 { -ng } else { ng };
         let ctx = ShadingContext::on_surface(p, n);
-        let field_vertex = guides.field.and_then(|f| f.vertex(p));
+        // One lookup per structure: the field's vertex serves both
+        // directions and lights.
+        let field_vertex = guides.field.and_then(|f| f.vertex(&ctx));
+        let light_vertex = match (field_vertex, guides.glt) {
+            (Some(v), _) => Some(v.light),
+            (None, Some(g)) => g.vertex(&ctx),
+            (None, None) => None,
+        };
+        let cell: Option<DirectionVertex> = match (field_vertex, guides.sd_tree) {
+            (Some(v), _) => Some(v.direction),
+            (None, Some(t)) => t.vertex(&ctx),
+            (None, None) => None,
+        };
         let resampled = guides.resample > 0
             && (guides.resample_vertices == 0 || scattered < guides.resample_vertices);
         let draws = if resampled
@@ -297,7 +229,7 @@ pub fn radiance<'a>(
         };
         scattered += 1;
         let here = Vertex {
-            at: field_vertex,
+            light: light_vertex,
             pos: p,
             normal: n,
             pdf_dir: 0.0,
@@ -306,26 +238,20 @@ pub fn radiance<'a>(
             resampled,
             nee: draws,
         };
-        let cell = match (field_vertex, guides.sd_tree) {
-            (Some(v), _) => Some(DirGuide::Field(v)),
-            (None, Some(t)) => t.vertex(p).map(|v| DirGuide::Sd(v.sd())),
-            (None, None) => None,
-        };
-        let frac = cell.map_or(1.0, |c| c.fraction());
+        let frac = cell.map_or(1.0, |c| c.bsdf_fraction());
         let dir_pdf = |wi: Vec3, bsdf_pdf: f32| match cell {
             Some(c) => {
-                let g = c.pdf(wi);
+                let g = c.direction_pdf(wi);
                 (frac * bsdf_pdf + (1.0 - frac) * g, g)
             }
             None => (bsdf_pdf, 0.0),
         };
-        // The field's (or the GLT's) vertex samples its cell's cut without
-        // a lookup per query.
-        let glt_vertex = guides.glt.and_then(|g| g.vertex(p));
-        let nee: &dyn LightSampler = match (&field_vertex, &glt_vertex) {
+        // The light vertex samples its cell's cut without a lookup per
+        // query.
+        let nee: &dyn LightSampler = match (&light_vertex, guides.lights) {
             (Some(v), _) => v,
-            (None, Some(v)) => v,
-            (None, None) => guides.lights,
+            (None, Some(fixed)) => fixed,
+            (None, None) => break,
         };
 
         // The direction the path continues in: BSDF sampling, or PPG's
@@ -338,7 +264,7 @@ pub fn radiance<'a>(
                 .map(|bs| (bs.wi, bs.weight * bs.pdf, bs.pdf))
         } else {
             cell.map(|c| {
-                let wi = c.sample([u2.x, u2.y]);
+                let wi = c.sample_direction([u2.x, u2.y]).0;
                 let (f, bsdf_pdf) = mat.eval(n, wo, wi);
                 (wi, f, bsdf_pdf)
             })
@@ -448,15 +374,15 @@ pub fn radiance<'a>(
             let value = splat_value(guides, f, lp.radiance) * factor;
             if visible {
                 recorder.add_radiance(c);
-                if train_light {
-                    splat_light(guides, &here, ls.light, value, s);
+                if let Some(l) = here.light.filter(|_| train_light) {
+                    l.record_light(ls.light, value);
                 }
             }
             // Visibility records come from light samples only (the
             // continuation's light is visible by construction).
-            if train_light && !known_visible {
+            if let Some(l) = here.light.filter(|_| train_light && !known_visible) {
                 let seen = if visible { value } else { 0.0 };
-                splat_visibility(guides, &here, ls.light, seen, value);
+                l.record_visibility(ls.light, seen, value);
             }
         }
 
@@ -466,7 +392,7 @@ pub fn radiance<'a>(
         };
         let weight = f_cos / pdf;
         if train_sd {
-            recorder.push_segment(field_vertex, p, wi, pdf, bsdf_pdf, guide_pdf, weight);
+            recorder.push_segment(cell, wi, pdf, bsdf_pdf, guide_pdf, weight);
         } else {
             recorder.scatter_unrecorded(weight);
         }
@@ -479,7 +405,7 @@ pub fn radiance<'a>(
         dir = wi;
     }
     if train_sd {
-        recorder.finish(guides, s.rng());
+        recorder.finish();
     }
     let l = recorder.estimate();
     if l.is_finite() { l } else { Vec3::ZERO }

@@ -144,7 +144,7 @@ impl Default for GuideParams {
             alpha: cut.alpha,
             modulation: cut.modulation,
             contribution_splats: false,
-            glt_filter: GltConfig::default().filter,
+            glt_filter: GltConfig::default().light_filter,
             prior: cut.prior,
             visibility: cut.visibility,
             resample: 0,
@@ -254,7 +254,7 @@ pub fn new_glt<'a>(
         cut: cut_config(scene, params),
         spatial_threshold: params.glt_spatial_threshold,
         max_bytes: None,
-        filter: params.glt_filter,
+        light_filter: params.glt_filter,
     };
     Some(Glt::new(&scene.light_tree, scene.bounds, config).expect("scene bounds are finite"))
 }

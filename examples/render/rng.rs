@@ -38,10 +38,4 @@ impl Sampler {
     pub fn next2(&mut self) -> Vec2 {
         Vec2::new(self.next(), self.next())
     }
-
-    /// The generator itself, for the crate's training calls that jitter.
-    #[inline]
-    pub fn rng(&mut self) -> &mut Pcg32 {
-        &mut self.rng
-    }
 }

@@ -478,14 +478,12 @@ pub fn guides<'r, 's: 'r>(
     params: &GuideParams,
     train: bool,
 ) -> Guides<'r> {
-    let lights: &(dyn LightSampler + Sync) = match (fixed, glt, field) {
-        (Some(f), _, _) => f.as_ref(),
-        (None, Some(g), _) => g,
-        (None, None, Some(f)) => f,
-        (None, None, None) => unreachable!("every method has a light sampler"),
-    };
+    assert!(
+        fixed.is_some() || glt.is_some() || field.is_some(),
+        "every method has a light sampler"
+    );
     Guides {
-        lights,
+        lights: fixed.as_deref(),
         glt: glt.as_ref(),
         sd_tree: sd_tree.as_ref(),
         field: field.as_ref(),

@@ -7,27 +7,25 @@ use crate::spatial::SpatialFilter;
 
 /// Everything a [`GuidingField`](super::GuidingField) is configured with:
 /// the SD-tree's parameters, the cuts' parameters and the filter of the
-/// light splats. `Default` is PPG's paper setup with the GLT's defaults.
+/// light records. `Default` is PPG's paper setup with the GLT's defaults.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FieldConfig {
     /// The SD-tree's parameters. Its spatial threshold `c` drives every
-    /// spatial split of the field (by the weight of the radiance splats, as
-    /// in PPG; light splats do not count); its filters are those of
-    /// [`GuidingField::splat_radiance`](super::GuidingField::splat_radiance);
+    /// spatial split of the field (by the weight of the radiance records, as
+    /// in PPG; light records do not count); its filters are those of
+    /// [`DirectionVertex::record_radiance`](crate::DirectionVertex::record_radiance);
     /// its `max_bytes` caps everything but the table the cells share
     /// ([`FieldMemory::capped`](super::FieldMemory::capped)).
     pub sd: SdTreeConfig,
     /// Every cell's cut.
     pub cut: CutConfig,
-    /// The spatial filter of
-    /// [`GuidingField::splat_light`](super::GuidingField::splat_light).
+    /// The spatial filter of light records
+    /// ([`LightVertex::record_light`](crate::LightVertex::record_light)).
     /// Default [`SpatialFilter::Nearest`], as
-    /// [`GltConfig::filter`](crate::glt::GltConfig::filter): a jittered
-    /// splat carries light through walls into cells that cannot see it
-    /// (measured in docs/experiments/light-selection.md, "The sealed dim
-    /// room").
-    /// [`SpatialFilter::StochasticBox`] draws its jitter as the GLT does
-    /// (one `next_u64` per splat).
+    /// [`GltConfig::light_filter`](crate::glt::GltConfig::light_filter): a
+    /// jittered record carries light through walls into cells that cannot
+    /// see it (measured in docs/experiments/light-selection.md, "The
+    /// sealed dim room").
     pub light_filter: SpatialFilter,
 }
 

@@ -5,24 +5,32 @@
 //!
 //! A renderer, at each path vertex `x`:
 //! 1. looks the cell up once: [`GuidingField::vertex`] gives a
-//!    [`FieldVertex`];
+//!    [`FieldVertex`], its [`direction`](FieldVertex::direction) and its
+//!    [`light`](FieldVertex::light) part;
 //! 2. samples the next direction from the BSDF or, with probability
-//!    `1 - s` ([`FieldVertex::bsdf_fraction`]), from the quadtree
-//!    ([`FieldVertex::sample_direction`]), and weighs with
-//!    [`FieldVertex::mixture_pdf`];
+//!    `1 - s` ([`DirectionVertex::bsdf_fraction`]), from the quadtree
+//!    ([`DirectionVertex::sample_direction`]), and weighs with
+//!    [`DirectionVertex::mixture_pdf`];
 //! 3. chooses a light for next-event estimation from the cell's cut: the
-//!    vertex is a [`LightSampler`] (`sample` / `pmf`);
+//!    light part is a [`LightSampler`](crate::LightSampler) (`sample` /
+//!    `pmf`);
 //! 4. records the direct-light estimate for the light it connected to
-//!    ([`FieldVertex::splat_light`], the GLT's record) and, once the path
+//!    ([`LightVertex::record_light`], the GLT's record) and, once the path
 //!    is done, the incident radiance along the sampled direction
-//!    ([`FieldVertex::splat_radiance`], PPG's record), optionally the
-//!    fraction sample ([`FieldVertex::record_fraction`]).
+//!    ([`DirectionVertex::record_radiance`], PPG's record), optionally the
+//!    fraction sample ([`DirectionVertex::record_fraction`]).
 //!
-//! The same records can be made by position ([`GuidingField::splat_radiance`],
-//! [`GuidingField::splat_light`], [`GuidingField::record_fraction`]), and the
-//! field itself is a [`LightSampler`] that locates the cell of
-//! `ctx.position`. Queries and records take `&self` from any number of
-//! threads; [`GuidingField::refine`] takes `&mut self` between iterations.
+//! The two parts are the same types an [`SdTree`](crate::sd_tree::SdTree)
+//! and a [`Glt`](crate::glt::Glt) give, so one integrator serves all three.
+//! Queries and records take `&self` from any number of threads;
+//! [`GuidingField::refine`] takes `&mut self` between iterations.
+//!
+//! [`DirectionVertex::bsdf_fraction`]: crate::DirectionVertex::bsdf_fraction
+//! [`DirectionVertex::sample_direction`]: crate::DirectionVertex::sample_direction
+//! [`DirectionVertex::mixture_pdf`]: crate::DirectionVertex::mixture_pdf
+//! [`DirectionVertex::record_radiance`]: crate::DirectionVertex::record_radiance
+//! [`DirectionVertex::record_fraction`]: crate::DirectionVertex::record_fraction
+//! [`LightVertex::record_light`]: crate::LightVertex::record_light
 //!
 //! ## Semantics: the SD-tree's and the GLT's, shared
 //!
@@ -56,7 +64,6 @@
 //! use guiding::light_tree::BuildHeuristic;
 //! use guiding::math::Aabb;
 //! use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
-//! use rand_core::SeedableRng;
 //!
 //! let lights = vec![
 //!     Emitter::point(Vec3::new(-3.0, 2.0, 0.0), 1.0),
@@ -67,31 +74,31 @@
 //! let mut config = FieldConfig::default();
 //! config.sd.spatial_threshold = 200.0;
 //! let mut field = GuidingField::new(&tree, scene, config)?;
-//! let mut rng = rand_pcg::Pcg32::seed_from_u64(1);
 //! // Two iterations: the first one's splits make a cell per side, the
 //! // second one's cuts learn their side.
 //! for _ in 0..2 {
 //!     for i in 0..2000 {
 //!         let x = Vec3::new((i % 20) as f32 * 0.4 - 3.8, 0.0, 0.0);
-//!         let v = field.vertex(x).expect("finite point");
+//!         let ctx = ShadingContext::at(x);
+//!         let v = field.vertex(&ctx).expect("finite point");
 //!         // NEE: the light on the same side contributes, the other is
 //!         // occluded.
-//!         let ctx = ShadingContext::at(x);
-//!         let s = v.sample(&ctx, (i % 7) as f32 / 7.0).expect("lights");
+//!         let s = v.light.sample(&ctx, (i % 7) as f32 / 7.0).expect("lights");
 //!         let LightId::Emitter(e) = s.light else { unreachable!() };
 //!         let seen = (e == 0) == (x.x < 0.0);
-//!         v.splat_light(s.light, if seen { 1.0 / s.pmf } else { 0.0 }, &mut rng);
+//!         v.light.record_light(s.light, if seen { 1.0 / s.pmf } else { 0.0 });
 //!         // Radiance arrives from above.
-//!         v.splat_radiance(Vec3::Y, 1.0, 1.0 / (4.0 * core::f32::consts::PI), &mut rng);
+//!         v.direction.record_radiance(Vec3::Y, 1.0, 1.0 / (4.0 * core::f32::consts::PI));
 //!     }
 //!     field.refine();
 //! }
-//! let v = field.vertex(Vec3::new(-3.0, 0.0, 0.0)).unwrap();
 //! let ctx = ShadingContext::at(Vec3::new(-3.0, 0.0, 0.0));
-//! assert!(v.pmf(&ctx, LightId::Emitter(0)) > 0.85);
-//! assert!(v.direction_pdf(Vec3::Y) > 4.0 * v.direction_pdf(-Vec3::Y));
-//! let (dir, pdf) = v.sample_direction([0.3, 0.6]);
-//! assert_eq!(pdf, v.direction_pdf(dir));
+//! let v = field.vertex(&ctx).unwrap();
+//! assert!(v.light.pmf(&ctx, LightId::Emitter(0)) > 0.85);
+//! let d = v.direction;
+//! assert!(d.direction_pdf(Vec3::Y) > 4.0 * d.direction_pdf(-Vec3::Y));
+//! let (dir, pdf) = d.sample_direction([0.3, 0.6]);
+//! assert_eq!(pdf, d.direction_pdf(dir));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
@@ -99,7 +106,6 @@ mod cell;
 mod config;
 mod memory;
 mod persist;
-mod splat;
 mod vertex;
 
 pub use cell::FieldCell;
@@ -107,11 +113,9 @@ pub use config::FieldConfig;
 pub use memory::FieldMemory;
 pub use vertex::FieldVertex;
 
-use crate::dropped::{DropReason, DroppedSplats};
-use crate::emitter::ShadingContext;
+use crate::dropped::DroppedRecords;
 use crate::error::Error;
-use crate::glt::{CutRules, SplatOutcome, octant_of};
-use crate::light_sampler::{LightId, LightSample, LightSampler};
+use crate::glt::CutRules;
 use crate::light_tree::LightHierarchy;
 use crate::math::Aabb;
 use crate::sd_tree::SdState;
@@ -153,25 +157,10 @@ impl<H: LightHierarchy> GuidingField<H> {
         })
     }
 
-    /// The one lookup per path vertex: the cell holding `p` (clamped onto
-    /// the root cube), through which all queries and records at `p` go.
-    /// `None` for a non-finite `p`.
-    #[inline]
-    pub fn vertex(&self, p: Vec3) -> Option<FieldVertex<'_, H>> {
-        let at = self.cells.locate_with_bounds(p)?;
-        Some(FieldVertex::new(self, p, at))
-    }
-
     /// The cell holding `p`, `None` for a non-finite point.
     #[inline]
     pub fn locate(&self, p: Vec3) -> Option<CellId> {
         self.cells.locate(p)
-    }
-
-    /// The data of the cell holding `p`.
-    #[inline]
-    fn cell_at(&self, p: Vec3) -> Option<&FieldCell> {
-        self.cells.locate(p).map(|c| self.cells.data(c))
     }
 
     /// Ends iteration `k = self.iteration()`: per cell, the SD-tree's step
@@ -239,83 +228,15 @@ impl<H: LightHierarchy> GuidingField<H> {
 
     /// Splats and fraction records dropped for bad input so far, per
     /// reason: radiance splats and fraction records as
-    /// [`SdTree::dropped_splats`](crate::sd_tree::SdTree::dropped_splats)
-    /// counts them, light splats in [`DroppedSplats::light`] (as
-    /// [`Glt::dropped_splats`](crate::glt::Glt::dropped_splats)).
-    pub fn dropped_splats(&self) -> DroppedSplats {
+    /// [`SdTree::dropped_records`](crate::sd_tree::SdTree::dropped_records)
+    /// counts them, light splats in [`DroppedRecords::light`] (as
+    /// [`Glt::dropped_records`](crate::glt::Glt::dropped_records)).
+    pub fn dropped_records(&self) -> DroppedRecords {
         self.sd.dropped.snapshot()
     }
 
     /// Sets all dropped-input counters to zero.
-    pub fn reset_dropped_splats(&mut self) {
+    pub fn reset_dropped_records(&mut self) {
         self.sd.dropped.reset();
-    }
-
-    /// A light splat through the shared GLT record, counting a drop.
-    #[inline]
-    fn record_light(
-        &self,
-        (p, at): (Vec3, Option<(CellId, Aabb)>),
-        light: LightId,
-        value: f32,
-        filter: (SpatialFilter, impl FnOnce() -> Vec3),
-    ) -> SplatOutcome {
-        let octant = at.map_or(0, |(_, bounds)| octant_of(p, &bounds));
-        let outcome = self
-            .guide
-            .splat_spread(&self.cells, (p, at), light, value, filter, |cell| {
-                cell.octants.count(octant);
-            });
-        if outcome == SplatOutcome::Dropped {
-            self.sd.dropped.count(DropReason::Light);
-        }
-        outcome
-    }
-}
-
-impl<H: LightHierarchy> LightSampler for GuidingField<H> {
-    /// Locates the cell of `ctx.position`, then applies the GLT's sampling
-    /// rule with its cut. `None` for a non-finite position.
-    #[inline]
-    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
-        self.guide.sample(&self.cell_at(ctx.position)?.cut, ctx, u)
-    }
-
-    #[inline]
-    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        self.cell_at(ctx.position)
-            .map_or(0.0, |cell| self.guide.pmf(&cell.cut, ctx, light))
-    }
-
-    fn is_empty(&self) -> bool {
-        self.guide.is_empty()
-    }
-
-    #[inline]
-    fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
-        self.guide
-            .sample_exact(&self.cell_at(ctx.position)?.cut, ctx, u)
-    }
-
-    #[inline]
-    fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
-        self.cell_at(ctx.position)
-            .map_or(0.0, |cell| self.guide.pmf_exact(&cell.cut, ctx, light))
-    }
-
-    /// The learned visibility of `light` in the cell of `ctx.position`
-    /// (1, without a lookup, when none is learned).
-    fn visibility(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        if !self.guide.config().visibility {
-            return 1.0;
-        }
-        self.cell_at(ctx.position)
-            .map_or(1.0, |cell| self.guide.visibility(&cell.cut, light))
-    }
-
-    /// One lookup and one walk.
-    fn sample_with_visibility(&self, ctx: &ShadingContext, u: f32) -> Option<(LightSample, f32)> {
-        let cell = self.cell_at(ctx.position)?;
-        self.guide.sample_with_visibility(&cell.cut, ctx, u)
     }
 }

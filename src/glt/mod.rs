@@ -49,6 +49,7 @@ mod refine;
 mod sampling;
 mod splat;
 mod standalone;
+mod vertex;
 mod visibility;
 mod walk;
 
@@ -58,6 +59,6 @@ pub use cut::{CutError, CutMemory, GuidingCut};
 pub use cut_node::{CutNode, Slot};
 pub use cut_rules::CutRules;
 pub(crate) use octants::{OctantSplats, octant_of};
-pub use splat::SplatOutcome;
-pub use standalone::{Glt, GltConfig, GltMemory, GltVertex};
-pub(crate) use visibility::valid_record;
+pub use standalone::{Glt, GltConfig, GltMemory};
+pub(crate) use vertex::LightCells;
+pub use vertex::LightVertex;

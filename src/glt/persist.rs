@@ -84,7 +84,7 @@ impl GltConfig {
         w.f64(self.spatial_threshold);
         w.bool(self.max_bytes.is_some());
         w.u64(self.max_bytes.unwrap_or(0) as u64);
-        w.u8(tag(&FILTERS, self.filter));
+        w.u8(tag(&FILTERS, self.light_filter));
     }
 
     fn read(r: &mut Reader<'_>) -> Result<Self, LoadError> {
@@ -97,7 +97,7 @@ impl GltConfig {
             cut,
             spatial_threshold,
             max_bytes: capped.then_some(usize::try_from(bytes).unwrap_or(usize::MAX)),
-            filter: untag(r, "glt config: filter", &FILTERS)?,
+            light_filter: untag(r, "glt config: filter", &FILTERS)?,
         };
         config.validate().map_err(|e| config_error(e, at))?;
         Ok(config)

@@ -41,9 +41,7 @@ use super::cut_node::CutNode;
 use super::cut_rules::{CutRules, decode_split};
 use super::walk::WalkNode;
 use crate::emitter::ShadingContext;
-use crate::light_sampler::{
-    FastQuery, ImportanceTable, LightId, LightSample, LightSampler, choose_unbounded,
-};
+use crate::light_sampler::{FastQuery, ImportanceTable, LightId, LightSample, choose_unbounded};
 use crate::light_tree::LightHierarchy;
 use crate::math::{Descent, Side, pmf_to_f32};
 
@@ -544,60 +542,6 @@ impl<H: LightHierarchy> CutRules<H> {
             return 0.0;
         }
         Rule::new(self, cut, ctx).pmf(light)
-    }
-
-    /// `cut` as a [`LightSampler`] (for one cell, or a renderer that keeps
-    /// its own spatial structure).
-    pub fn sampler<'b>(&'b self, cut: &'b GuidingCut) -> impl LightSampler + Copy + 'b {
-        CutSampler { guide: self, cut }
-    }
-}
-
-/// One cell's cut with its [`CutRules`], as a [`LightSampler`].
-struct CutSampler<'b, H: LightHierarchy> {
-    guide: &'b CutRules<H>,
-    cut: &'b GuidingCut,
-}
-
-impl<H: LightHierarchy> Clone for CutSampler<'_, H> {
-    fn clone(&self) -> Self {
-        *self
-    }
-}
-
-impl<H: LightHierarchy> Copy for CutSampler<'_, H> {}
-
-impl<H: LightHierarchy> LightSampler for CutSampler<'_, H> {
-    #[inline]
-    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
-        self.guide.sample(self.cut, ctx, u)
-    }
-
-    #[inline]
-    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        self.guide.pmf(self.cut, ctx, light)
-    }
-
-    fn is_empty(&self) -> bool {
-        self.guide.is_empty()
-    }
-
-    #[inline]
-    fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
-        self.guide.sample_exact(self.cut, ctx, u)
-    }
-
-    #[inline]
-    fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
-        self.guide.pmf_exact(self.cut, ctx, light)
-    }
-
-    fn visibility(&self, _ctx: &ShadingContext, light: LightId) -> f32 {
-        self.guide.visibility(self.cut, light)
-    }
-
-    fn sample_with_visibility(&self, ctx: &ShadingContext, u: f32) -> Option<(LightSample, f32)> {
-        self.guide.sample_with_visibility(self.cut, ctx, u)
     }
 }
 

@@ -5,22 +5,8 @@ use super::cut::GuidingCut;
 use super::cut_rules::CutRules;
 use crate::light_sampler::LightId;
 use crate::light_tree::LightHierarchy;
+use crate::record::RecordOutcome;
 use glam::Vec3;
-
-/// What became of one splat.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum SplatOutcome {
-    /// The value was added to a slot's (or an unbounded light's) sum.
-    Recorded,
-    /// The value was zero (an occluded or black sample): a valid
-    /// observation that adds nothing to the sums. It still counts as a
-    /// sample for spatial refinement.
-    Zero,
-    /// Bad input, ignored: a negative, NaN or infinite value, an emitter out
-    /// of range or with zero power (no cut can give it weight), or an
-    /// unbounded light beyond [`CutConfig::unbounded`](super::CutConfig::unbounded)'s count.
-    Dropped,
-}
 
 impl GuidingCut {
     /// Index of the sum that a splat for `emitter` goes to: the first slot on
@@ -79,15 +65,15 @@ impl<H: LightHierarchy> CutRules<H> {
     /// The splat carries no position, so a cut trained only through this
     /// call has no anchor for [`Modulation::Importance`]; use
     /// [`CutRules::splat_from`] there.
-    pub fn splat(&self, cut: &GuidingCut, light: LightId, value: f32) -> SplatOutcome {
+    pub fn splat(&self, cut: &GuidingCut, light: LightId, value: f32) -> RecordOutcome {
         if !(value >= 0.0 && value.is_finite()) {
-            return SplatOutcome::Dropped;
+            return RecordOutcome::Dropped;
         }
         let Some(index) = self.sum_of(cut, light) else {
-            return SplatOutcome::Dropped;
+            return RecordOutcome::Dropped;
         };
         if value == 0.0 {
-            return SplatOutcome::Zero;
+            return RecordOutcome::Zero;
         }
         if cut.sums.add(index, value) {
             // Only the data floor reads the count: the paper's rule
@@ -95,9 +81,9 @@ impl<H: LightHierarchy> CutRules<H> {
             if self.config().min_splats > 0 {
                 cut.recorded.bump();
             }
-            SplatOutcome::Recorded
+            RecordOutcome::Recorded
         } else {
-            SplatOutcome::Dropped
+            RecordOutcome::Dropped
         }
     }
 
@@ -112,7 +98,7 @@ impl<H: LightHierarchy> CutRules<H> {
         from: Vec3,
         light: LightId,
         value: f32,
-    ) -> SplatOutcome {
+    ) -> RecordOutcome {
         self.splat_weighted_from(cut, from, 1.0, light, value)
     }
 
@@ -127,9 +113,9 @@ impl<H: LightHierarchy> CutRules<H> {
         weight: f32,
         light: LightId,
         value: f32,
-    ) -> SplatOutcome {
+    ) -> RecordOutcome {
         let outcome = self.splat(cut, light, value);
-        if outcome == SplatOutcome::Recorded && self.config().modulation != Modulation::None {
+        if outcome == RecordOutcome::Recorded && self.config().modulation != Modulation::None {
             cut.record_position(from, weight);
         }
         outcome

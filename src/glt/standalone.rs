@@ -1,26 +1,23 @@
 //! [`Glt`]: the Guiding Light Tree over its own spatial tree, for renderers
 //! without directional guiding. One [`GuidingCut`] per cell of PPG's spatial
-//! binary tree; it is itself a [`LightSampler`].
+//! binary tree, each path vertex answered through its [`LightVertex`].
 
 use super::cell::GltCell;
 use super::config::CutConfig;
-use super::cut::{CutMemory, GuidingCut};
+use super::cut::CutMemory;
 use super::cut_node::CutNode;
 use super::cut_rules::CutRules;
 use super::octants::octant_of;
-use super::splat::SplatOutcome;
-use super::visibility::valid_record;
-use crate::dropped::{DropCounters, DropReason, DroppedSplats};
+use super::vertex::{LightCells, LightVertex};
+use crate::dropped::{DropCounters, DropReason, DroppedRecords};
 use crate::emitter::ShadingContext;
 use crate::error::{ConfigError, Error};
-use crate::light_sampler::{LightId, LightSample, LightSampler};
+use crate::light_sampler::LightId;
 use crate::light_tree::LightHierarchy;
 use crate::math::Aabb;
-use crate::math::pmf_to_f32;
-use crate::spatial::{
-    BinaryTree, CellId, RefineOutcome, SpatialFilter, SpatialTree, jitter_offset,
-};
-use crate::spatial::{Growth, Jitter, content_scale};
+use crate::record::RecordOutcome;
+use crate::spatial::{BinaryTree, CellId, RefineOutcome, SpatialFilter, SpatialTree};
+use crate::spatial::{Growth, content_scale};
 use glam::Vec3;
 
 /// Parameters of a [`Glt`]: the cuts' and the spatial tree's.
@@ -49,14 +46,15 @@ pub struct GltConfig {
     /// cap cannot shrink below what the cells hold whatever their nodes
     /// (one sum each, the anchor sums).
     pub max_bytes: Option<usize>,
-    /// The spatial filter of [`Glt::splat`]. Default
+    /// The spatial filter of light records
+    /// ([`LightVertex::record_light`]). Default
     /// [`SpatialFilter::Nearest`]: the estimate goes to the cell holding
     /// the shading point. A jittering filter carries a splat into the
     /// neighbouring cells, also through walls, where the light it saw may
     /// be invisible; a dim room beside bright ones then learns its
     /// neighbours' lights and samples worse than without learning
     /// (`tests/glt_walls.rs`).
-    pub filter: SpatialFilter,
+    pub light_filter: SpatialFilter,
 }
 
 impl GltConfig {
@@ -75,7 +73,7 @@ impl Default for GltConfig {
             cut: CutConfig::default(),
             spatial_threshold: 250.0,
             max_bytes: None,
-            filter: SpatialFilter::Nearest,
+            light_filter: SpatialFilter::Nearest,
         }
     }
 }
@@ -114,11 +112,12 @@ impl GltMemory {
 
 /// The Guiding Light Tree over its own spatial tree: one learned cut per
 /// cell of PPG's binary tree over the scene, sampled by the GLT's sampling
-/// rule (see `sampling.rs` and [`GuidingCut`]).
+/// rule (see `sampling.rs` and [`GuidingCut`](super::GuidingCut)).
 ///
-/// Per iteration a renderer samples lights with [`LightSampler::sample`]
-/// (any number of threads), splats the resulting direct-light estimates
-/// with [`Glt::splat`] (idem), then calls [`Glt::refine`] once.
+/// Per iteration a renderer locates each path vertex once
+/// ([`Glt::vertex`]), samples lights and records what each sample found
+/// through the [`LightVertex`] (any number of threads), then calls
+/// [`Glt::refine`] once.
 ///
 /// `H` is the light hierarchy, held as the renderer chooses: owned
 /// (`Glt<LightTree>`), shared with the scene (`Glt<Arc<LightTree>>`) or
@@ -176,120 +175,17 @@ impl<H: LightHierarchy> Glt<H> {
         self.iteration
     }
 
-    /// The cut of the cell holding `p` (`None` for a non-finite point).
-    #[inline]
-    pub(crate) fn cut_at(&self, p: Vec3) -> Option<&GuidingCut> {
-        let cell = self.spatial.locate(p)?;
-        Some(&self.spatial.data(cell).cut)
-    }
-
-    /// Splats dropped as bad input so far, all in [`DroppedSplats::light`]:
-    /// non-finite or negative values or positions, emitters out of range or
+    /// Records dropped as bad input so far: vertices asked for at
+    /// non-finite positions in [`DroppedRecords::position`], the rest in
+    /// [`DroppedRecords::light`]: non-finite or negative values, emitters out of range or
     /// with zero power, unbounded lights beyond the configured count.
-    pub fn dropped_splats(&self) -> DroppedSplats {
+    pub fn dropped_records(&self) -> DroppedRecords {
         self.dropped.snapshot()
     }
 
     /// Sets the dropped-input counters to zero.
-    pub fn reset_dropped_splats(&mut self) {
+    pub fn reset_dropped_records(&mut self) {
         self.dropped.reset();
-    }
-
-    /// Records a direct-light estimate `value` for `light` seen from `p` (see
-    /// [`CutRules::splat`] for what the value is) into the cell(s) that
-    /// [`GltConfig::filter`] spreads `p` over: by default the cell holding
-    /// `p`. With [`SpatialFilter::StochasticBox`] `p` is first jittered
-    /// uniformly inside a box the size of its cell centred on it (PPG's
-    /// stochastic box, +-1/2 cell per axis, the paper's code uses +-1/4;
-    /// three numbers from `jitter`, see [`Jitter`]), which smooths cuts
-    /// across cell borders but also carries light through walls. `&self`:
-    /// any number of threads at once.
-    pub fn splat<J: Jitter + ?Sized>(
-        &self,
-        p: Vec3,
-        light: LightId,
-        value: f32,
-        jitter: &mut J,
-    ) -> SplatOutcome {
-        let at = self.spatial.locate_with_bounds(p);
-        self.splat_filtered(p, at, light, value, self.config.filter, || {
-            jitter_offset(jitter)
-        })
-    }
-
-    /// Like [`Glt::splat`] with [`SpatialFilter::Nearest`] whatever the
-    /// configuration: the estimate goes to the cell holding `p`.
-    pub fn splat_at(&self, p: Vec3, light: LightId, value: f32) -> SplatOutcome {
-        let at = self.spatial.locate_with_bounds(p);
-        self.splat_filtered(p, at, light, value, SpatialFilter::Nearest, || Vec3::ZERO)
-    }
-
-    /// A light splat from `p`, located at `at` (`None`: non-finite `p`).
-    pub(super) fn splat_filtered(
-        &self,
-        p: Vec3,
-        at: Option<(CellId, Aabb)>,
-        light: LightId,
-        value: f32,
-        filter: SpatialFilter,
-        jitter: impl FnOnce() -> Vec3,
-    ) -> SplatOutcome {
-        let octant = at.map_or(0, |(_, bounds)| octant_of(p, &bounds));
-        let outcome = self.guide.splat_spread(
-            &self.spatial,
-            (p, at),
-            light,
-            value,
-            (filter, jitter),
-            |cell| cell.octants.count(octant),
-        );
-        if outcome == SplatOutcome::Dropped {
-            self.reject();
-        }
-        outcome
-    }
-
-    /// Records what a next-event sample of `light` from `p` saw, for the
-    /// learned visibility ([`CutConfig::visibility`]): the value recorded
-    /// for it (0 when blocked) and the value it would have been without
-    /// occluders ([`CutRules::splat_visibility`]), into the cell holding
-    /// `p` (visibility is never carried into neighbouring cells). Bad input
-    /// is dropped and counted.
-    ///
-    /// [`CutConfig::visibility`]: super::CutConfig::visibility
-    pub fn splat_visibility(
-        &self,
-        p: Vec3,
-        light: LightId,
-        shadowed: f32,
-        unshadowed: f32,
-    ) -> SplatOutcome {
-        let outcome = if !self.config.cut.visibility {
-            // Nothing is learned: the values are checked, `p` is not
-            // looked up (the renderer may record whatever the
-            // configuration, at no cost).
-            if valid_record(shadowed, unshadowed) {
-                SplatOutcome::Zero
-            } else {
-                SplatOutcome::Dropped
-            }
-        } else {
-            match self.cut_at(p) {
-                Some(cut) => self
-                    .guide
-                    .splat_visibility(cut, light, shadowed, unshadowed),
-                None => SplatOutcome::Dropped,
-            }
-        };
-        if outcome == SplatOutcome::Dropped {
-            self.reject();
-        }
-        outcome
-    }
-
-    #[inline]
-    fn reject(&self) {
-        self.dropped.count(DropReason::Light);
     }
 
     /// Turns what was recorded into the cuts sampled next, cell by cell
@@ -304,7 +200,7 @@ impl<H: LightHierarchy> Glt<H> {
     /// it took part in, a half taken to have half its parent's splats: PPG's
     /// rule, with the cell's own clock); both halves get a copy of the cut
     /// and its sums, and each the confidence of its share of the records
-    /// ([`GuidingCut::confidence`]). Then its cut is rebuilt from its sums
+    /// ([`GuidingCut::confidence`](super::GuidingCut::confidence)). Then its cut is rebuilt from its sums
     /// ([`CutRules::refine`]; a cut that collected nothing keeps its
     /// distribution) within the memory budget. A renderer that refines
     /// after every iteration of PPG's doubling schedule makes every cell
@@ -371,18 +267,56 @@ impl<H: LightHierarchy> Glt<H> {
         self.spatial.locate(p)
     }
 
-    /// The one lookup per path vertex: the cell holding `p` (clamped onto
-    /// the root cube), through which light selection and light splats at
-    /// `p` go. `None` for a non-finite `p`.
+    /// The one lookup per path vertex: the cell holding `ctx.position`
+    /// (clamped onto the root cube), through which light selection and
+    /// light records at that point go. `None` for a non-finite position
+    /// (counted in [`DroppedRecords::position`]: nothing can be recorded
+    /// there).
     #[inline]
-    pub fn vertex(&self, p: Vec3) -> Option<GltVertex<'_, H>> {
+    pub fn vertex(&self, ctx: &ShadingContext) -> Option<LightVertex<'_, H>> {
+        let Some(v) = self.vertex_uncounted(ctx.position) else {
+            self.dropped.count(DropReason::Position);
+            return None;
+        };
+        Some(v)
+    }
+
+    /// [`Glt::vertex`] at `p` without counting a non-finite `p` (for
+    /// [`Strategy`](crate::Strategy)'s queries by position).
+    #[inline]
+    pub(crate) fn vertex_uncounted(&self, p: Vec3) -> Option<LightVertex<'_, H>> {
         let at = self.spatial.locate_with_bounds(p)?;
-        Some(GltVertex {
-            glt: self,
-            cut: &self.spatial.data(at.0).cut,
-            p,
+        let cut = &self.spatial.data(at.0).cut;
+        Some(LightVertex::new(&self.guide, cut, (p, at), self))
+    }
+}
+
+impl<H: LightHierarchy> LightCells for Glt<H> {
+    #[inline]
+    fn record_light(
+        &self,
+        at: (Vec3, (CellId, Aabb)),
+        light: LightId,
+        value: f32,
+    ) -> RecordOutcome {
+        let octant = octant_of(at.0, &at.1.1);
+        let outcome = self.guide.record_spread(
+            &self.spatial,
             at,
-        })
+            light,
+            value,
+            self.config.light_filter,
+            |cell| cell.octants.count(octant),
+        );
+        if outcome == RecordOutcome::Dropped {
+            self.count_dropped();
+        }
+        outcome
+    }
+
+    #[inline]
+    fn count_dropped(&self) {
+        self.dropped.count(DropReason::Light);
     }
 }
 
@@ -392,201 +326,5 @@ impl core::iter::Sum for CutMemory {
             a += b;
             a
         })
-    }
-}
-
-impl<H: LightHierarchy> CutRules<H> {
-    /// Records the direct-light estimate `value` for `light` made at a point
-    /// into the cuts of the cells of `cells` that `filter` spreads the point
-    /// over (each cell's part `value * weight`), through
-    /// [`CutRules::splat`]. `at` is the point and its
-    /// `locate_with_bounds` (`None` for a non-finite point: dropped);
-    /// `jitter` is that of [`BinaryTree::spread_from`]. `accepted` is called for every cell whose cut took its part
-    /// ([`SplatOutcome::Recorded`] or [`SplatOutcome::Zero`]). The caller
-    /// counts a [`SplatOutcome::Dropped`] result, once per call.
-    ///
-    /// Shared by [`Glt`] and the combined guiding field
-    /// ([`crate::field`]).
-    #[inline]
-    pub(crate) fn splat_spread<C: AsRef<GuidingCut>>(
-        &self,
-        cells: &BinaryTree<C>,
-        (p, at): (Vec3, Option<(CellId, Aabb)>),
-        light: LightId,
-        value: f32,
-        (filter, jitter): (SpatialFilter, impl FnOnce() -> Vec3),
-        accepted: impl Fn(&C),
-    ) -> SplatOutcome {
-        let Some(at) = at else {
-            return SplatOutcome::Dropped;
-        };
-        let mut outcome = SplatOutcome::Zero;
-        cells.spread_from(p, at, filter, jitter, |cell, weight| {
-            let cell = cells.data(cell);
-            match self.splat_weighted_from(cell.as_ref(), p, weight, light, value * weight) {
-                SplatOutcome::Dropped => outcome = SplatOutcome::Dropped,
-                o => {
-                    accepted(cell);
-                    if o == SplatOutcome::Recorded && outcome != SplatOutcome::Dropped {
-                        outcome = o;
-                    }
-                }
-            }
-        });
-        outcome
-    }
-}
-
-impl<H: LightHierarchy> LightSampler for Glt<H> {
-    /// Locates the cell of `ctx.position`, then applies the GLT's sampling
-    /// rule with its cut. `None` for a non-finite position.
-    #[inline]
-    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
-        self.guide.sample(self.cut_at(ctx.position)?, ctx, u)
-    }
-
-    #[inline]
-    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        pmf_to_f32(self.pmf_exact(ctx, light))
-    }
-
-    fn is_empty(&self) -> bool {
-        self.guide.is_empty()
-    }
-
-    #[inline]
-    fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
-        self.guide.sample_exact(self.cut_at(ctx.position)?, ctx, u)
-    }
-
-    #[inline]
-    fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
-        self.cut_at(ctx.position)
-            .map_or(0.0, |cut| self.guide.pmf_exact(cut, ctx, light))
-    }
-
-    /// The learned visibility of `light` in the cell of `ctx.position`
-    /// (1, without a lookup, when none is learned).
-    fn visibility(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        if !self.config.cut.visibility {
-            return 1.0;
-        }
-        self.cut_at(ctx.position)
-            .map_or(1.0, |cut| self.guide.visibility(cut, light))
-    }
-
-    /// One lookup and one walk.
-    fn sample_with_visibility(&self, ctx: &ShadingContext, u: f32) -> Option<(LightSample, f32)> {
-        let cut = self.cut_at(ctx.position)?;
-        self.guide.sample_with_visibility(cut, ctx, u)
-    }
-}
-
-/// A path vertex located in a [`Glt`] ([`Glt::vertex`]): light selection
-/// and light splats at that point without looking the cell up again, as
-/// [`FieldVertex`](crate::field::FieldVertex) does for the combined field.
-/// Every answer equals the GLT's by position at the same point.
-#[derive(Debug)]
-pub struct GltVertex<'g, H: LightHierarchy> {
-    glt: &'g Glt<H>,
-    cut: &'g GuidingCut,
-    p: Vec3,
-    at: (CellId, Aabb),
-}
-
-impl<H: LightHierarchy> Clone for GltVertex<'_, H> {
-    fn clone(&self) -> Self {
-        *self
-    }
-}
-
-impl<H: LightHierarchy> Copy for GltVertex<'_, H> {}
-
-impl<'g, H: LightHierarchy> GltVertex<'g, H> {
-    /// The point this vertex was located from.
-    #[inline]
-    pub fn position(&self) -> Vec3 {
-        self.p
-    }
-
-    /// The cell's number.
-    #[inline]
-    pub fn cell(&self) -> CellId {
-        self.at.0
-    }
-
-    /// The located cell's cut.
-    #[inline]
-    pub fn cut(&self) -> &'g GuidingCut {
-        self.cut
-    }
-
-    /// [`Glt::splat`] at this vertex's position: a direct-light estimate
-    /// `value` for `light` (`Le * w_mis / pmf` for NEE, see
-    /// [`CutRules::splat`]).
-    #[inline]
-    pub fn splat_light<J: Jitter + ?Sized>(
-        &self,
-        light: LightId,
-        value: f32,
-        jitter: &mut J,
-    ) -> SplatOutcome {
-        let g = self.glt;
-        g.splat_filtered(self.p, Some(self.at), light, value, g.config.filter, || {
-            jitter_offset(jitter)
-        })
-    }
-}
-
-impl<H: LightHierarchy> GltVertex<'_, H> {
-    /// [`Glt::splat_visibility`] at this vertex's cell.
-    #[inline]
-    pub fn splat_visibility(&self, light: LightId, shadowed: f32, unshadowed: f32) -> SplatOutcome {
-        let outcome = self
-            .glt
-            .guide
-            .splat_visibility(self.cut, light, shadowed, unshadowed);
-        if outcome == SplatOutcome::Dropped {
-            self.glt.reject();
-        }
-        outcome
-    }
-}
-
-impl<H: LightHierarchy> LightSampler for GltVertex<'_, H> {
-    /// Applies the GLT's sampling rule with the located cell's cut.
-    #[inline]
-    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
-        self.glt.guide.sample(self.cut, ctx, u)
-    }
-
-    #[inline]
-    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        self.glt.guide.pmf(self.cut, ctx, light)
-    }
-
-    fn is_empty(&self) -> bool {
-        self.glt.guide.is_empty()
-    }
-
-    #[inline]
-    fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
-        self.glt.guide.sample_exact(self.cut, ctx, u)
-    }
-
-    #[inline]
-    fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
-        self.glt.guide.pmf_exact(self.cut, ctx, light)
-    }
-
-    /// The learned visibility of `light` in the located cell.
-    fn visibility(&self, _ctx: &ShadingContext, light: LightId) -> f32 {
-        self.glt.guide.visibility(self.cut, light)
-    }
-
-    /// One walk: the visibility is read where it leaves the cut.
-    #[inline]
-    fn sample_with_visibility(&self, ctx: &ShadingContext, u: f32) -> Option<(LightSample, f32)> {
-        self.glt.guide.sample_with_visibility(self.cut, ctx, u)
     }
 }

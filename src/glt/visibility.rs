@@ -28,9 +28,9 @@
 use super::cut::{GuidingCut, MIN_VISIBILITY, visibility_slots};
 use super::cut_node::{CutNode, Slot};
 use super::cut_rules::CutRules;
-use super::splat::SplatOutcome;
 use crate::light_sampler::LightId;
 use crate::light_tree::LightHierarchy;
+use crate::record::RecordOutcome;
 use alloc::vec::Vec;
 
 /// Pseudo-records of the shrinkage towards a slot's previous visibility.
@@ -42,9 +42,9 @@ impl<H: LightHierarchy> CutRules<H> {
     /// the shadow ray was blocked), `unshadowed` the value it would have
     /// been without occluders (the same scalar as
     /// [`CutRules::splat`]'s). A sample the renderer skipped (a zero
-    /// BSDF, say) is not a record. [`SplatOutcome::Zero`] when the
+    /// BSDF, say) is not a record. [`RecordOutcome::Ignored`] when the
     /// configuration learns no visibility (then nothing else is looked at
-    /// but the values) or `unshadowed` is 0; [`SplatOutcome::Dropped`] for
+    /// but the values), [`RecordOutcome::Zero`] when `unshadowed` is 0; [`RecordOutcome::Dropped`] for
     /// values that are negative, not finite, or with `shadowed >
     /// unshadowed`, and, while learning, lights out of range. `&self`:
     /// any number of threads at once.
@@ -54,25 +54,25 @@ impl<H: LightHierarchy> CutRules<H> {
         light: LightId,
         shadowed: f32,
         unshadowed: f32,
-    ) -> SplatOutcome {
+    ) -> RecordOutcome {
         if !valid_record(shadowed, unshadowed) {
-            return SplatOutcome::Dropped;
+            return RecordOutcome::Dropped;
         }
         if cut.visibility.is_empty() {
             // Nothing to learn: no lookup either, so the renderer can make
             // these records whatever the configuration.
-            return SplatOutcome::Zero;
+            return RecordOutcome::Ignored;
         }
         let Some(index) = self.sum_of(cut, light) else {
-            return SplatOutcome::Dropped;
+            return RecordOutcome::Dropped;
         };
         if unshadowed == 0.0 {
-            return SplatOutcome::Zero;
+            return RecordOutcome::Zero;
         }
         cut.seen.add(2 * index, shadowed);
         cut.seen.add(2 * index + 1, unshadowed);
         cut.seen_records.bump();
-        SplatOutcome::Recorded
+        RecordOutcome::Recorded
     }
 
     /// The learned visibility of `light` in `cut`: its slot's (1 when the

@@ -58,7 +58,7 @@
 //! Zero-valued records (an occluded shadow ray, a path that found no light)
 //! are valid observations everywhere in the crate: they add nothing to the
 //! sums but count as samples for the spatial split rules, so record them as
-//! they come (the GLT's splats return `SplatOutcome::Zero` for them).
+//! they come (the light records return `RecordOutcome::Zero` for them).
 //!
 //! One weight per iteration (from the variance averaged over the image), not
 //! per pixel: per-pixel weights computed from the same few passes correlate

@@ -18,9 +18,10 @@ pub struct SdTreeConfig {
     pub spatial_threshold: f64,
     /// Directional refinement: `rho` and the depth limit of the quadtrees.
     pub quadtree: QuadtreeConfig,
-    /// Spatial filter used by [`SdTree::splat`](super::SdTree::splat).
+    /// Spatial filter of radiance records
+    /// ([`DirectionVertex::record_radiance`](super::DirectionVertex::record_radiance)).
     pub spatial_filter: SpatialFilter,
-    /// Directional filter used by [`SdTree::splat`](super::SdTree::splat).
+    /// Directional filter of radiance records.
     pub directional_filter: DirectionalFilter,
     /// How training sums accumulate; `Deterministic` makes the learned state
     /// bit-identical whatever the thread count.

@@ -2,21 +2,23 @@
 //! binary tree ([`BinaryTree`]) whose cells ([`SdCell`]) hold directional
 //! quadtrees ([`DirectionalTree`](crate::quadtree::DirectionalTree)).
 //!
-//! A renderer, at each path vertex `p`:
-//! - samples a direction with [`SdTree::sample`] (with probability
-//!   `1 - s`, `s =` [`SdTree::bsdf_fraction`]) or its BSDF, and weighs with
-//!   [`SdTree::mixture_pdf`];
+//! A renderer, at each path vertex, locates it once ([`SdTree::vertex`]) and
+//! through the [`DirectionVertex`]:
+//! - samples a direction with [`DirectionVertex::sample_direction`] (with
+//!   probability `1 - s`, `s =` [`DirectionVertex::bsdf_fraction`]) or its
+//!   BSDF, and weighs with [`DirectionVertex::mixture_pdf`];
 //! - once the path is done, records the incident radiance it found along the
-//!   sampled direction with [`SdTree::splat`];
+//!   sampled direction with [`DirectionVertex::record_radiance`]
+//!   ([`PathRecorder`](crate::PathRecorder) does the bookkeeping);
 //! - optionally reports the sample to the fraction learner with
-//!   [`SdTree::record_fraction`].
+//!   [`DirectionVertex::record_fraction`].
 //!
-//! Between iterations it calls [`SdTree::refine`]. Queries and splats take
+//! Between iterations it calls [`SdTree::refine`]. Queries and records take
 //! `&self` and may run from many threads; `refine` takes `&mut self`.
 //!
-//! ## What a splat records
+//! ## What a radiance record records
 //!
-//! `splat(p, dir, radiance, pdf, ..)` is PPG's record: the directional
+//! `record_radiance(dir, radiance, pdf)` is PPG's record: the directional
 //! quadtree of the cell receives `radiance / pdf` (an estimate of the
 //! irradiance-like integral that makes the learned density proportional to
 //! incident radiance), and the cell's statistical weight grows by 1, the
@@ -25,8 +27,8 @@
 //! (the mixture's, as PPG). With the box filter each overlapped cell gets
 //! the overlapped fraction of the box volume of both. Radiance 0 is valid:
 //! it adds weight and no power. Invalid input is dropped, counted per
-//! reason ([`SdTree::dropped_splats`]) and never stored:
-//! a non-finite position, a NaN, infinite or zero-length direction, a NaN,
+//! reason ([`SdTree::dropped_records`]) and never stored:
+//! a NaN, infinite or zero-length direction, a NaN,
 //! infinite or negative radiance, a zero, negative or non-finite pdf, or
 //! `radiance / pdf` overflowing `f32`. Nothing panics.
 //!
@@ -83,24 +85,27 @@
 //! ```
 //! use guiding::math::Aabb;
 //! use guiding::sd_tree::{SdTree, SdTreeConfig};
+//! use guiding::{RecordOutcome, ShadingContext};
 //! use glam::Vec3;
-//! use rand_core::SeedableRng;
 //!
 //! let scene = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
 //! let mut tree = SdTree::new(scene, SdTreeConfig { spatial_threshold: 100.0, ..Default::default() })?;
-//! let mut rng = rand_pcg::Pcg32::seed_from_u64(1);
 //! for i in 0..1000 {
-//!     let p = Vec3::new((i % 10) as f32 * 0.2 - 0.9, 0.0, 0.0);
+//!     let ctx = ShadingContext::at(Vec3::new((i % 10) as f32 * 0.2 - 0.9, 0.0, 0.0));
+//!     let v = tree.vertex(&ctx).expect("a finite point");
 //!     // Radiance 1 arriving from +z, sampled with pdf 1 / (4 pi).
-//!     tree.splat(p, Vec3::Z, 1.0, 1.0 / (4.0 * core::f32::consts::PI), &mut rng);
+//!     v.record_radiance(Vec3::Z, 1.0, 1.0 / (4.0 * core::f32::consts::PI));
 //! }
-//! assert!(!tree.splat(Vec3::ZERO, Vec3::Z, f32::NAN, 1.0, &mut rng));
+//! let origin = ShadingContext::at(Vec3::ZERO);
+//! let v = tree.vertex(&origin).unwrap();
+//! assert_eq!(v.record_radiance(Vec3::Z, f32::NAN, 1.0), RecordOutcome::Dropped);
 //! tree.refine();
 //! assert!(tree.cell_count() > 1);
-//! let (dir, pdf) = tree.sample(Vec3::ZERO, [0.5, 0.5]).unwrap();
-//! assert_eq!(pdf, tree.pdf(Vec3::ZERO, dir));
-//! assert!(tree.pdf(Vec3::ZERO, Vec3::Z) > 10.0 * tree.pdf(Vec3::ZERO, -Vec3::Z));
-//! assert_eq!(tree.dropped_splats().radiance, 1);
+//! let v = tree.vertex(&origin).unwrap();
+//! let (dir, pdf) = v.sample_direction([0.5, 0.5]);
+//! assert_eq!(pdf, v.direction_pdf(dir));
+//! assert!(v.direction_pdf(Vec3::Z) > 10.0 * v.direction_pdf(-Vec3::Z));
+//! assert_eq!(tree.dropped_records().radiance, 1);
 //! # Ok::<(), guiding::Error>(())
 //! ```
 
@@ -109,7 +114,6 @@ mod config;
 mod fraction;
 mod memory;
 mod persist;
-mod query;
 mod refine;
 mod splat;
 mod state;
@@ -120,9 +124,10 @@ pub use cell::SdCell;
 pub use config::SdTreeConfig;
 pub use memory::SdTreeMemory;
 pub(crate) use state::SdState;
-pub use vertex::SdVertex;
+pub use vertex::DirectionVertex;
+pub(crate) use vertex::RadianceCells;
 
-use crate::dropped::DroppedSplats;
+use crate::dropped::DroppedRecords;
 use crate::error::Error;
 use crate::math::Aabb;
 use crate::spatial::BinaryTree;
@@ -172,12 +177,12 @@ impl SdTree {
     }
 
     /// Splats and fraction records dropped for bad input so far, per reason.
-    pub fn dropped_splats(&self) -> DroppedSplats {
+    pub fn dropped_records(&self) -> DroppedRecords {
         self.state.dropped.snapshot()
     }
 
     /// Sets the dropped-input counters to zero.
-    pub fn reset_dropped_splats(&mut self) {
+    pub fn reset_dropped_records(&mut self) {
         self.state.dropped.reset();
     }
 }

@@ -16,8 +16,8 @@ pub enum SpatialFilter {
     #[default]
     Nearest,
     /// The position is jittered uniformly within a box the size of the cell
-    /// containing it (`+-1/2` cell per axis, random bits from the caller's
-    /// `rand_core::Rng`), then the cell containing the jittered position
+    /// containing it (`+-1/2` cell per axis, from a hash of the record:
+    /// `src/spatial/jitter.rs`), then the cell containing the jittered position
     /// (clamped to the root) takes all of it. Same cost as `Nearest`, the
     /// box filter in expectation.
     StochasticBox,

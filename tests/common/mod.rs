@@ -295,3 +295,7 @@ pub fn chi_square_z(observed: &[u64], probs: &[f64]) -> Option<(f64, usize)> {
     let z = ((chi2 / k).cbrt() - (1.0 - v)) / v.sqrt();
     Some((z, kept.len() - 1))
 }
+
+mod at_point;
+#[allow(unused_imports)]
+pub use at_point::{ByPosition, DirectionsAt, LightsAt};

@@ -1,0 +1,235 @@
+//! [`LightVertex`]: a located cell's learned light choice, the one
+//! cut-based [`LightSampler`], serving every light query and record at a
+//! path vertex for the GLT and the guiding field alike.
+
+use super::cut::GuidingCut;
+use super::cut_rules::CutRules;
+use crate::emitter::ShadingContext;
+use crate::light_sampler::{LightId, LightSample, LightSampler};
+use crate::light_tree::LightHierarchy;
+use crate::math::Aabb;
+use crate::record::RecordOutcome;
+use crate::spatial::{BinaryTree, CellId, SpatialFilter, SpatialTree, record_offset};
+use glam::Vec3;
+
+/// Where a light vertex's records go: the cells of a [`Glt`](super::Glt)
+/// or of a [`GuidingField`](crate::field::GuidingField) (a stochastic filter may
+/// carry a record into a neighbouring cell), and their drop counter.
+pub(crate) trait LightCells {
+    /// The GLT's record of the estimate `value` for `light`, made at `p`
+    /// located at `at`, with the configured filter; counts a drop.
+    fn record_light(&self, at: (Vec3, (CellId, Aabb)), light: LightId, value: f32)
+    -> RecordOutcome;
+
+    /// Counts one dropped light record.
+    fn count_dropped(&self);
+}
+
+/// The salt of a light record's stochastic-box offset
+/// (`src/spatial/jitter.rs`): which light it is.
+#[inline]
+pub(crate) fn light_salt(light: LightId) -> [u32; 3] {
+    match light {
+        LightId::Emitter(e) => [e, 0x4c45_4d49, 0],
+        LightId::Unbounded(i) => [i, 0x4c55_4e42, 1],
+    }
+}
+
+/// A path vertex's light choice: the cut of the cell of a
+/// [`Glt`](super::Glt) ([`Glt::vertex`](super::Glt::vertex)) or of a
+/// [`GuidingField`](crate::field::GuidingField)
+/// ([`FieldVertex::light`](crate::FieldVertex::light)) found by the one
+/// lookup, sampled by the GLT's sampling rule (`src/glt/sampling.rs`), and
+/// the records that teach it.
+///
+/// It is a [`LightSampler`]: `sample` and `pmf` answer for the located
+/// cell's cut whatever `ctx.position` is (`ctx` feeds the importance rules
+/// at the shading point; pass the context the vertex was made from). At
+/// each vertex a renderer chooses a light with `sample`, weighs BSDF
+/// samples that hit an emitter with `pmf`, and records what each light
+/// sample found with [`LightVertex::record_light`] (and, to learn each
+/// cluster's visibility, [`LightVertex::record_visibility`]).
+#[derive(Clone, Copy)]
+pub struct LightVertex<'a, H: LightHierarchy> {
+    rules: &'a CutRules<H>,
+    cut: &'a GuidingCut,
+    p: Vec3,
+    /// The cells records go to and where the vertex is in them; `None`
+    /// for a lone cut ([`CutRules::vertex`]).
+    cells: Option<(&'a dyn LightCells, (CellId, Aabb))>,
+}
+
+impl<H: LightHierarchy> core::fmt::Debug for LightVertex<'_, H> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("LightVertex")
+            .field("position", &self.p)
+            .field("cell", &self.cells.map(|c| c.1.0))
+            .field("cut", &self.cut)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<'a, H: LightHierarchy> LightVertex<'a, H> {
+    /// The vertex at `p`, located at `at` in `cells`, whose cut is `cut`.
+    #[inline]
+    pub(crate) fn new(
+        rules: &'a CutRules<H>,
+        cut: &'a GuidingCut,
+        (p, at): (Vec3, (CellId, Aabb)),
+        cells: &'a dyn LightCells,
+    ) -> Self {
+        Self {
+            rules,
+            cut,
+            p,
+            cells: Some((cells, at)),
+        }
+    }
+
+    /// The point this vertex was located from.
+    #[inline]
+    pub fn position(&self) -> Vec3 {
+        self.p
+    }
+
+    /// The located cell's cut.
+    #[inline]
+    pub fn cut(&self) -> &'a GuidingCut {
+        self.cut
+    }
+
+    /// Records a light sample's estimate: `value` is what the sample of
+    /// `light` contributed, MIS-weighted and divided by its pdf, without
+    /// the BSDF and the cosine (from NEE, `Le * T * w_mis / (pmf *
+    /// pdf_solid_angle)`; from a BSDF sample that hit an emitter, `Le *
+    /// w_mis / pdf_direction`; one scalar, e.g. luminance;
+    /// [`mis::DirectLight::estimate`](crate::mis::DirectLight::estimate)
+    /// gives it). Occluded samples record 0 ([`RecordOutcome::Zero`]): a
+    /// valid observation. It goes to the cut of the vertex's cell (or,
+    /// with a jittering filter configured, of the cell at the jittered
+    /// point), into the first slot on `light`'s path that ends the cut.
+    /// Dropped and counted: a negative or non-finite value, an emitter out
+    /// of range or without power, an unbounded light beyond the configured
+    /// count. `&self`: any number of threads at once, no update lost.
+    #[inline]
+    pub fn record_light(&self, light: LightId, value: f32) -> RecordOutcome {
+        match self.cells {
+            Some((cells, at)) => cells.record_light((self.p, at), light, value),
+            None => self.rules.splat_from(self.cut, self.p, light, value),
+        }
+    }
+
+    /// Records what a next-event sample of `light` saw, for the learned
+    /// visibility ([`CutConfig::visibility`](super::CutConfig::visibility)):
+    /// `shadowed` is the value recorded for it (0 when the shadow ray was
+    /// blocked) and `unshadowed` the value it would have been without
+    /// occluders. It goes to the vertex's own cell (visibility is never
+    /// carried into neighbouring cells). [`RecordOutcome::Ignored`] when
+    /// no visibility is learned; dropped and counted: values negative, not
+    /// finite or with `shadowed > unshadowed`, lights out of range.
+    #[inline]
+    pub fn record_visibility(
+        &self,
+        light: LightId,
+        shadowed: f32,
+        unshadowed: f32,
+    ) -> RecordOutcome {
+        let outcome = self
+            .rules
+            .splat_visibility(self.cut, light, shadowed, unshadowed);
+        if outcome == RecordOutcome::Dropped {
+            if let Some((cells, _)) = self.cells {
+                cells.count_dropped();
+            }
+        }
+        outcome
+    }
+}
+
+impl<H: LightHierarchy> CutRules<H> {
+    /// `cut` as a vertex at `ctx.position`, for a renderer that keeps its
+    /// own spatial structure: it samples by the GLT's rule and its records
+    /// go to `cut` alone (nothing counts its drops: the outcome says).
+    pub fn vertex<'a>(&'a self, cut: &'a GuidingCut, ctx: &ShadingContext) -> LightVertex<'a, H> {
+        LightVertex {
+            rules: self,
+            cut,
+            p: ctx.position,
+            cells: None,
+        }
+    }
+
+    /// Records the estimate `value` for `light` made at `p` (located at
+    /// `at` in `cells`) into the cuts of the cells that `filter` spreads
+    /// the point over (each cell's part `value * weight`), the stochastic
+    /// box's offset hashed from the record. `accepted` is called for every
+    /// cell whose cut took its part ([`RecordOutcome::Recorded`] or
+    /// [`RecordOutcome::Zero`]). The caller counts a
+    /// [`RecordOutcome::Dropped`] result, once per call. Shared by
+    /// [`Glt`](super::Glt) and the guiding field.
+    #[inline]
+    pub(crate) fn record_spread<C: AsRef<GuidingCut>>(
+        &self,
+        cells: &BinaryTree<C>,
+        (p, at): (Vec3, (CellId, Aabb)),
+        light: LightId,
+        value: f32,
+        filter: SpatialFilter,
+        accepted: impl Fn(&C),
+    ) -> RecordOutcome {
+        let mut outcome = RecordOutcome::Zero;
+        let jitter = || record_offset(p, light_salt(light));
+        cells.spread_from(p, at, filter, jitter, |cell, weight| {
+            let cell = cells.data(cell);
+            match self.splat_weighted_from(cell.as_ref(), p, weight, light, value * weight) {
+                RecordOutcome::Dropped => outcome = RecordOutcome::Dropped,
+                o => {
+                    accepted(cell);
+                    if o == RecordOutcome::Recorded && outcome != RecordOutcome::Dropped {
+                        outcome = o;
+                    }
+                }
+            }
+        });
+        outcome
+    }
+}
+
+impl<H: LightHierarchy> LightSampler for LightVertex<'_, H> {
+    /// Applies the GLT's sampling rule with the located cell's cut.
+    #[inline]
+    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+        self.rules.sample(self.cut, ctx, u)
+    }
+
+    #[inline]
+    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        self.rules.pmf(self.cut, ctx, light)
+    }
+
+    fn is_empty(&self) -> bool {
+        self.rules.is_empty()
+    }
+
+    #[inline]
+    fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
+        self.rules.sample_exact(self.cut, ctx, u)
+    }
+
+    #[inline]
+    fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
+        self.rules.pmf_exact(self.cut, ctx, light)
+    }
+
+    /// The learned visibility of `light` in the located cell (1 where
+    /// none is learned).
+    fn visibility(&self, _ctx: &ShadingContext, light: LightId) -> f32 {
+        self.rules.visibility(self.cut, light)
+    }
+
+    /// One walk: the visibility is read where it leaves the cut.
+    #[inline]
+    fn sample_with_visibility(&self, ctx: &ShadingContext, u: f32) -> Option<(LightSample, f32)> {
+        self.rules.sample_with_visibility(self.cut, ctx, u)
+    }
+}
