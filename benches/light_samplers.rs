@@ -15,8 +15,8 @@ use guiding::light_sampler::{
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::{Aabb, LightCone};
 use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
-use rand_core::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
+use rand_pcg::rand_core::{Rng, SeedableRng};
 use std::hint::black_box;
 use std::time::Duration;
 

@@ -9,8 +9,8 @@ use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_ma
 use glam::{Vec2, Vec3};
 use guiding::math::{Accumulation, canonical_to_dir};
 use guiding::quadtree::{DirectionalFilter, DirectionalTree, NODE_BYTES, QuadtreeConfig};
-use rand_core::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
+use rand_pcg::rand_core::{Rng, SeedableRng};
 use std::hint::black_box;
 
 const DEPTHS: [u32; 4] = [4, 8, 12, 16];

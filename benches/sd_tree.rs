@@ -12,8 +12,8 @@ use guiding::quadtree::{DirectionalFilter, NODE_BYTES, UNIFORM_PDF};
 use guiding::sd_tree::{SdTree, SdTreeConfig};
 use guiding::spatial::SpatialFilter;
 use guiding::spatial::SpatialTree;
-use rand_core::{Rng, SeedableRng};
 use rand_pcg::Pcg32;
+use rand_pcg::rand_core::{Rng, SeedableRng};
 use std::hint::black_box;
 use std::time::Duration;
 

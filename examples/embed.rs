@@ -14,13 +14,11 @@
 //! cargo run --release --example embed
 //! ```
 
-use glam::Vec3;
-use guiding::glt::{Glt, GltConfig};
-use guiding::light_sampler::UniformSampler;
-use guiding::light_tree::BuildHeuristic;
-use guiding::math::Aabb;
-use guiding::mis::Convention;
-use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
+use guiding::glam::Vec3;
+use guiding::{
+    Aabb, BuildHeuristic, Convention, Emitter, Glt, GltConfig, LightId, LightSampler, LightTree,
+    ShadingContext, Strategy, UnboundedLights,
+};
 use rand_pcg::Pcg32;
 use rand_pcg::rand_core::{Rng, SeedableRng};
 use std::f32::consts::PI;
@@ -229,7 +227,8 @@ pub fn run() -> bool {
             .map(|i| s.pmf(&left, LightId::Emitter(i)))
             .sum()
     };
-    let uniform_sampler = UniformSampler::new(lights.len());
+    let uniform_sampler =
+        Strategy::new("uniform", &emitters[..], UnboundedLights::NONE, bounds).expect("lights");
     let by_uniform = Nee::Fixed(&uniform_sampler);
     println!("32 sphere lights, a wall at x = 0; 64 floor points; 16 samples per estimate");
     println!(

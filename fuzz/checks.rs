@@ -156,7 +156,7 @@ pub mod load {
     fn load_checked(data: &[u8]) {
         if let Ok(t) = LightTree::from_bytes(data) {
             check(
-                &guiding::ImportanceTreeSampler::new(&t),
+                &guiding::light_sampler::ImportanceTreeSampler::new(&t),
                 t.nodes().len() as u32,
             );
         }
@@ -180,11 +180,10 @@ pub mod load {
 pub mod build {
 
     use guiding::glam::Vec3;
+    use guiding::light_sampler::ImportanceTreeSampler;
     use guiding::light_tree::BuildHeuristic;
     use guiding::math::{Aabb, LightCone};
-    use guiding::{
-        Emitter, ImportanceTreeSampler, LightId, LightSampler, LightTree, ShadingContext,
-    };
+    use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
 
     fn f(b: &[u8]) -> f32 {
         f32::from_le_bytes([b[0], b[1], b[2], b[3]])

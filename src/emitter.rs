@@ -242,7 +242,7 @@ pub struct ShadingContext {
     /// on `|cos|` to it, so its sign does not matter (a light behind the
     /// surface counts as one in front: transmission), and a light gets
     /// nothing from it only when all of it lies exactly in the tangent
-    /// plane, where that cosine is 0 (see [`crate::light_sampler::importance`]).
+    /// plane, where that cosine is 0 (see `crate::light_sampler::importance`).
     pub normal: Option<Vec3>,
 }
 

@@ -1,34 +1,48 @@
 #![doc = include_str!("../README.md")]
 //!
+//! ## The front
+//!
+//! Everything a renderer needs is at the crate root:
+//! - the lights and the shading point: [`Emitter`] (or your own
+//!   [`Emitters`]), [`LightTree`] ([`BuildHeuristic`]), [`ShadingContext`],
+//!   [`Aabb`];
+//! - choosing lights: the [`LightSampler`] trait ([`LightSample`],
+//!   [`LightId`]), the baselines by name ([`Strategy`]: uniform, power,
+//!   pbrt-v4's light BVH), the scene's sun and sky ([`UnboundedLights`]);
+//! - the guides: [`Glt`] (lights), [`SdTree`] (directions) and
+//!   [`GuidingField`] (both in one spatial tree), each with its
+//!   configuration ([`GltConfig`] and [`CutConfig`], [`SdTreeConfig`],
+//!   [`FieldConfig`]);
+//! - at a path vertex: `vertex(&ctx)` of a guide gives a [`LightVertex`]
+//!   (the GLT's), a [`DirectionVertex`] (the SD-tree's) or both
+//!   ([`FieldVertex`]), the same two types for every guide, so an
+//!   integrator is written once; they sample, evaluate and record, and
+//!   every record answers a [`RecordOutcome`];
+//! - around the integrator: [`DirectLight`] (what a light sample
+//!   contributes and records under pbrt-v4's or pbrt-v3's
+//!   [`Convention`]), [`resample`] (resampled light choice),
+//!   [`PathRecorder`] (a path's bookkeeping and its radiance records),
+//!   [`Iterations`] and [`InverseVarianceCombiner`] (PPG's schedule and
+//!   combination), [`SharedGuide`] (render threads sharing a guide that any
+//!   of them refines);
+//! - errors: [`Error`], [`ConfigError`], [`LoadError`], and the
+//!   [`DroppedRecords`] count of bad input.
+//!
+//! Each guide owns (or shares, or borrows) its light tree; constructors
+//! validate their configuration. The `inspect` feature makes every module
+//! public (a cut's nodes, the spatial tree's cells, the quadtrees, the save
+//! format's pieces, the research knobs' types): the tests, benchmarks and
+//! research examples use it; a renderer does not need it.
+//!
 //! ## Layers
 //!
-//! Each module only uses the ones above it:
-//! 1. [`math`]: boxes, cones, the sphere map, the exact one-number
-//!    descent (`src/math/descent.rs`), thread-safe sums (`src/math/sum.rs`);
-//! 2. [`emitter`]: the [`Emitters`] trait and [`ShadingContext`];
-//! 3. [`light_tree`]: [`LightHierarchy`] and the [`LightTree`] BVH;
-//! 4. [`light_sampler`]: [`LightSampler`] and its baselines;
-//! 5. [`spatial`]: the spatial tree trait and PPG's binary tree;
-//! 6. [`quadtree`] and [`sd_tree`]: PPG's directional quadtree and SD-tree;
-//! 7. [`glt`]: the Guiding Light Tree, itself a [`LightSampler`];
-//! 8. [`field`]: one spatial tree holding a quadtree and a cut per cell, as
-//!    the paper uses them; [`schedule`]: PPG's iteration schedule and the
-//!    inverse-variance combination of the last iterations;
-//! 9. for the integrator: [`Strategy`] (a light sampler by name),
-//!    [`PathRecorder`] (a path's bookkeeping and its records) and [`mis`]
-//!    (the MIS heuristics, and what a direct-light sample contributes and
-//!    records under pbrt-v4's or pbrt-v3's convention); with `std`,
-//!    [`shared_guide`] (a guide the render threads share and any of them
-//!    refines, through `&self`);
-//! 10. [`persist`]: saving, loading and merging what was learned.
-//!
-//! Each of [`sd_tree::SdTree`], [`glt::Glt`] and [`field::GuidingField`]
-//! locates a path vertex once with `vertex(&ctx)` and answers and records
-//! through what it gives: a [`DirectionVertex`] (the SD-tree's), a
-//! [`LightVertex`] (the GLT's) or both ([`FieldVertex`]), the same two
-//! types for every structure, so an integrator is written once; every
-//! record answers a [`RecordOutcome`]. Each owns (or shares, or borrows)
-//! its light tree; constructors validate their configuration ([`Error`]).
+//! Each module (`src/`) only uses the ones above it: `math` (boxes, cones,
+//! the sphere map, the exact one-number descent, thread-safe sums),
+//! `emitter`, `light_tree`, `light_sampler`, `spatial` (PPG's binary
+//! tree), `quadtree` and `sd_tree`, `glt`, `field`, `schedule`, then for the
+//! integrator `strategy`, `path_recorder`, `mis`, `resampling`,
+//! `shared_guide`, and `persist` (saving, loading and merging what was
+//! learned).
 //!
 //! ## Where things are
 //!
@@ -54,8 +68,8 @@
 //!   same input, and pmfs sum to 1 (or are all 0 when nothing can be sampled).
 //! - Queries and records take `&self` and may run from many threads; `refine`
 //!   takes `&mut self` between iterations (or `&self` through
-//!   [`shared_guide::SharedGuide`]). [`math::Accumulation::Deterministic`]
-//!   makes learned state bit-identical whatever the thread count.
+//!   [`SharedGuide`]). [`Accumulation::Deterministic`] makes learned state
+//!   bit-identical whatever the thread count.
 //! - Bad input never panics: builds return typed errors, records drop and
 //!   count it ([`DroppedRecords`]); invalid configuration is an error, never
 //!   a silent clamp.
@@ -70,64 +84,95 @@
 //! | a light's power ([`Emitter::power`], [`Emitters::power`]) | its flux, one scalar (the luminance of an RGB power, or any fixed positive weighting), the same unit for every kind: a point light of intensity `I`, `4 pi I`; a spot light of peak intensity `I`, `4 pi I` too (pbrt-v4's convention: a point light as bright, its cone bounds where it shines; [`Emitter::spot`]); a one-sided Lambertian area light of radiance `L` and area `A`, `pi L A` (two-sided: `2 pi L A`); a sphere of radius `r`, `4 pi^2 r^2 L`; textured emission: the integral of `pi L` over the surface (per side) |
 //! | sun, sky and other lights with no position | not emitters: [`UnboundedLights`] with their number and the probability they share; `0.25` shared is what the render example uses beside many lights (for the GLT it is only the prior's share and the defensive floor, each cell learns its own); pbrt-v4's fixed choice uses `count / (count + 1)` |
 //! | which normal ([`ShadingContext::on_surface`]) | the shading normal, the one in the cosine of the estimate; its sign does not matter; none ([`ShadingContext::at`]) in media |
-//! | what a light sample records ([`LightVertex::record_light`]) | `luminance(Le) * factor` with the [`mis::DirectLight`] factor of its convention: the light's arriving radiance, not times the BSDF and cosine, MIS-weighted and divided by the pdf; [`mis::DirectLight::estimate`] gives the contribution and the record from one call, for pbrt-v4's or pbrt-v3's convention ([`mis::Convention`]) |
+//! | what a light sample records ([`LightVertex::record_light`]) | `luminance(Le) * factor` with the [`DirectLight`] factor of its convention: the light's arriving radiance, not times the BSDF and cosine, MIS-weighted and divided by the pdf; [`DirectLight::estimate`] gives the contribution and the record from one call, for pbrt-v4's or pbrt-v3's convention ([`Convention`]) |
 //! | random numbers for a record | none: the stochastic box filter (off by default for light records) takes its offset from a hash of the record (`src/spatial/jitter.rs`), so the same records learn the same state on any thread count |
-//! | an occluded sample, a light behind the surface, a BSDF that is zero (and the shadow ray skipped) | record 0 or nothing, never a shadow ray for the record's sake: a zero adds nothing to what is learned; it only counts as a sample for the split and refinement rules, which then follow where paths go rather than where light arrives ([`schedule`]) |
-//! | when to call `refine` | after each of PPG's doubling iterations ([`schedule::Iterations`]); a renderer that renders each tile to completion, after every wave of tiles (as many as it has threads): a GLT cell refines once it holds 3/2 of its records before ([`glt::GltCell`], [`schedule`]) |
-//! | the spatial threshold | [`glt::GltConfig::default`]'s, measured for renderers (docs/experiments/tile-order.md) |
+//! | an occluded sample, a light behind the surface, a BSDF that is zero (and the shadow ray skipped) | record 0 or nothing, never a shadow ray for the record's sake: a zero adds nothing to what is learned; it only counts as a sample for the split and refinement rules, which then follow where paths go rather than where light arrives |
+//! | when to call `refine` | after each of PPG's doubling iterations ([`Iterations`]); a renderer that renders each tile to completion, after every wave of tiles (as many as it has threads): a GLT cell refines once it holds 3/2 of its records before ([`Glt::refine`]) |
+//! | the spatial threshold | [`GltConfig::default`]'s, measured for renderers (docs/experiments/tile-order.md) |
 //!
 //! ## Features
 //!
 //! - `std` (default): use the standard library. Without it the crate is
 //!   `#![no_std]` with `alloc` and uses `libm`.
+//! - `inspect`: every module public (the second tier, above).
 
 #![cfg_attr(not(feature = "std"), no_std)]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
+// Without `inspect` the modules are private and the second tier's items
+// (used by the tests and benchmarks through `inspect`) are unreachable; with
+// it every module is public, and the compiler checks what is truly unused.
+#![cfg_attr(not(feature = "inspect"), allow(dead_code, unused_imports))]
 
 extern crate alloc;
 
-mod dropped;
-pub mod emitter;
-pub mod error;
-pub mod field;
-pub mod glt;
-pub mod light_sampler;
-pub mod light_tree;
-pub mod math;
-pub mod mis;
-pub mod path_recorder;
-pub mod persist;
-pub mod quadtree;
-mod record;
-pub mod resampling;
-pub mod schedule;
-pub mod sd_tree;
-#[cfg(feature = "std")]
-pub mod shared_guide;
-pub mod spatial;
-mod strategy;
+/// Declares the crate's modules: private by default, so the crate root's
+/// re-exports below are the whole front a renderer sees; public with the
+/// `inspect` feature, which the tests, benchmarks and research examples
+/// enable to reach the second tier (a cut's nodes, the spatial tree's
+/// cells, the quadtrees, the save format's pieces).
+macro_rules! layers {
+    ($($(#[$attr:meta])* $name:ident;)*) => {
+        $(
+            $(#[$attr])*
+            #[cfg(feature = "inspect")]
+            pub mod $name;
+            $(#[$attr])*
+            #[cfg(not(feature = "inspect"))]
+            mod $name;
+        )*
+    };
+}
+
+layers! {
+    dropped;
+    emitter;
+    error;
+    field;
+    glt;
+    light_sampler;
+    light_tree;
+    math;
+    mis;
+    path_recorder;
+    persist;
+    quadtree;
+    record;
+    resampling;
+    schedule;
+    sd_tree;
+    #[cfg(feature = "std")]
+    shared_guide;
+    spatial;
+    strategy;
+}
 
 /// The vector types of the public API (`Vec3`, ...): glam 0.34, re-exported
 /// so a renderer on another glam version names the crate's own.
 pub use glam;
-/// The random-number trait that filtered records take (`RngCore`):
-/// rand_core 0.10, re-exported so a renderer on another version can wrap
-/// its generator in this one's trait.
-pub use rand_core;
 
-pub use dropped::DroppedRecords;
+// The lights and the shading point.
 pub use emitter::{Emitter, Emitters, ShadingContext};
-pub use error::{ConfigError, Error};
-pub use field::FieldVertex;
-pub use glt::LightVertex;
-pub use light_sampler::{
-    ImportanceTreeSampler, LightId, LightSample, LightSampler, PowerSampler, PowerTreeSampler,
-    UnboundedLights, UniformSampler, WithUnbounded,
-};
-pub use light_tree::{LightHierarchy, LightTree};
-pub use path_recorder::PathRecorder;
-pub use persist::LoadError;
-pub use record::RecordOutcome;
-pub use sd_tree::DirectionVertex;
+pub use light_tree::{BuildError, BuildHeuristic, LightHierarchy, LightTree};
+pub use math::{Aabb, Accumulation};
+// Choosing lights.
+pub use light_sampler::{LightId, LightSample, LightSampler, UnboundedLights};
 pub use strategy::Strategy;
+// The guides, their configurations and their vertices.
+pub use field::{FieldConfig, FieldVertex, GuidingField};
+pub use glt::{CutConfig, Glt, GltConfig, LightVertex};
+pub use quadtree::{DirectionalFilter, QuadtreeConfig};
+pub use sd_tree::{DirectionVertex, SdTree, SdTreeConfig};
+pub use spatial::{RefineOutcome, SpatialFilter};
+// What a renderer records and computes with them.
+pub use dropped::DroppedRecords;
+pub use mis::{Convention, DirectEstimate, DirectLight};
+pub use path_recorder::PathRecorder;
+pub use record::RecordOutcome;
+pub use resampling::{BsdfCandidate, Evaluated, Resampled, resample};
+pub use schedule::{InverseVarianceCombiner, Iterations};
+#[cfg(feature = "std")]
+pub use shared_guide::SharedGuide;
+// Errors.
+pub use error::{ConfigError, Error};
+pub use persist::LoadError;

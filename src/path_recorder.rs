@@ -71,7 +71,7 @@ pub struct Segment<'a> {
 }
 
 /// The bookkeeping of one path at a time (reuse it between paths: its
-/// storage is kept). See the [module docs](self).
+/// storage is kept). See the module docs.
 #[derive(Clone, Debug)]
 pub struct PathRecorder<'a> {
     segments: Vec<Segment<'a>>,

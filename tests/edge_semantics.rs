@@ -10,11 +10,11 @@ use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
 use guiding::field::{FieldConfig, GuidingField};
 use guiding::glt::{CutConfig, CutRules, Glt, GltConfig};
-use guiding::light_tree::BuildHeuristic;
-use guiding::{
-    ImportanceTreeSampler, LightId, LightSampler, LightTree, PowerSampler, PowerTreeSampler,
-    ShadingContext, UnboundedLights, UniformSampler, WithUnbounded,
+use guiding::light_sampler::{
+    ImportanceTreeSampler, PowerSampler, PowerTreeSampler, UniformSampler, WithUnbounded,
 };
+use guiding::light_tree::BuildHeuristic;
+use guiding::{LightId, LightSampler, LightTree, ShadingContext, UnboundedLights};
 
 /// The largest `f32` below one.
 const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;

@@ -6,9 +6,10 @@ mod common;
 
 use common::Rand;
 use glam::Vec3;
+use guiding::light_sampler::ImportanceTreeSampler;
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Aabb;
-use guiding::{Emitter, ImportanceTreeSampler, LightId, LightSampler, LightTree, ShadingContext};
+use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
 use std::f32::consts::PI;
 
 fn contains(b: &Aabb, p: Vec3) -> bool {

@@ -15,9 +15,10 @@ use common::{Rand, two_rooms, value};
 use glam::Vec3;
 use guiding::field::{FieldConfig, GuidingField};
 use guiding::glt::{Glt, GltConfig};
+use guiding::light_sampler::ImportanceTreeSampler;
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Aabb;
-use guiding::{Emitter, ImportanceTreeSampler, LightId, LightSampler, LightTree, ShadingContext};
+use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
 
 const OFFSETS: [f32; 3] = [1e3, 1e5, 1e7];
 

@@ -27,16 +27,14 @@ use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
 use guiding::field::{FieldConfig, GuidingField};
 use guiding::glt::{BelowCut, CutConfig, Glt, GltConfig, Modulation, Prior, SplitPrior};
+use guiding::light_sampler::ImportanceTreeSampler;
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Accumulation;
 use guiding::persist::FORMAT_VERSION;
 use guiding::quadtree::DirectionalFilter;
 use guiding::sd_tree::{SdTree, SdTreeConfig};
 use guiding::spatial::SpatialFilter;
-use guiding::{
-    ImportanceTreeSampler, LightId, LightSampler, LightTree, LoadError, ShadingContext,
-    UnboundedLights,
-};
+use guiding::{LightId, LightSampler, LightTree, LoadError, ShadingContext, UnboundedLights};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 

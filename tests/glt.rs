@@ -1293,7 +1293,7 @@ fn below_cut_importance_is_the_importance_walk() {
     let mut rng = Rand::new(41);
     let lights = lights_in_box(&mut rng, 300, 10.0);
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
-    let bvh = guiding::ImportanceTreeSampler::new(&tree);
+    let bvh = guiding::light_sampler::ImportanceTreeSampler::new(&tree);
     let [left, right] = tree.children(tree.root().unwrap()).unwrap();
     let under = |n: u32| {
         let mut out = Vec::new();

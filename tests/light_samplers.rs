@@ -14,8 +14,8 @@ use guiding::light_tree::{BuildHeuristic, LightHierarchy, NodeBounds};
 use guiding::math::{Aabb, LightCone};
 use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
 use proptest::prelude::*;
-use rand_core::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
+use rand_pcg::rand_core::{Rng, SeedableRng};
 
 // ---------------------------------------------------------------------------
 // Random numbers and scenes

@@ -7,8 +7,8 @@ use guiding::math::{Accumulation, canonical_to_dir, dir_to_canonical};
 use guiding::quadtree::{
     DirectionalFilter, DirectionalTree, NODE_BYTES, QuadLeaf, QuadtreeConfig, UNIFORM_PDF,
 };
-use rand_core::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
+use rand_pcg::rand_core::{Rng, SeedableRng};
 use std::collections::HashMap;
 
 mod common;

@@ -12,11 +12,10 @@ use common::{ByPosition, LightsAt};
 use common::{Rand, scene, two_rooms, unshadowed, value};
 use glam::Vec3;
 use guiding::glt::{Glt, GltConfig};
+use guiding::light_sampler::{ImportanceTreeSampler, UniformSampler};
 use guiding::light_tree::BuildHeuristic;
 use guiding::resampling::{Evaluated, resample};
-use guiding::{
-    ImportanceTreeSampler, LightId, LightSampler, LightTree, ShadingContext, UniformSampler,
-};
+use guiding::{LightId, LightSampler, LightTree, ShadingContext};
 
 /// Candidate numbers that make a uniform sampler over `n` lights draw
 /// exactly `lights`.

@@ -5,8 +5,8 @@
 use guiding::schedule::{
     InverseVarianceCombiner, Iterations, PassStats, next_iteration, next_iteration_by_time,
 };
-use rand_core::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
+use rand_pcg::rand_core::{Rng, SeedableRng};
 
 fn uniform(rng: &mut Pcg64) -> f64 {
     (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64

@@ -11,8 +11,8 @@ use guiding::sd_tree::{SdTree, SdTreeConfig};
 use guiding::spatial::SpatialFilter;
 use guiding::spatial::SpatialTree;
 use guiding::{RecordOutcome, ShadingContext};
-use rand_core::{Rng, SeedableRng};
 use rand_pcg::Pcg32;
+use rand_pcg::rand_core::{Rng, SeedableRng};
 
 fn scene() -> Aabb {
     Aabb::new(Vec3::new(-2.0, -1.0, -1.0), Vec3::new(2.0, 1.0, 1.0))

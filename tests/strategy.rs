@@ -7,10 +7,10 @@ use common::{ByPosition, LightsAt};
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
 use guiding::glt::{Glt, GltConfig};
+use guiding::light_sampler::{ImportanceTreeSampler, PowerSampler, UniformSampler, WithUnbounded};
 use guiding::light_tree::{BuildError, BuildHeuristic};
 use guiding::{
-    Emitter, Error, ImportanceTreeSampler, LightId, LightSampler, LightTree, PowerSampler,
-    ShadingContext, Strategy, UnboundedLights, UniformSampler, WithUnbounded,
+    Emitter, Error, LightId, LightSampler, LightTree, ShadingContext, Strategy, UnboundedLights,
 };
 
 const NONE: UnboundedLights = UnboundedLights::NONE;

@@ -15,7 +15,7 @@ pub struct FieldConfig {
     /// in PPG; light records do not count); its filters are those of
     /// [`DirectionVertex::record_radiance`](crate::DirectionVertex::record_radiance);
     /// its `max_bytes` caps everything but the table the cells share
-    /// ([`FieldMemory::capped`](super::FieldMemory::capped)).
+    /// (`FieldMemory::capped`).
     pub sd: SdTreeConfig,
     /// Every cell's cut.
     pub cut: CutConfig,

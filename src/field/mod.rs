@@ -123,7 +123,7 @@ use crate::spatial::{BinaryTree, CellId, RefineOutcome, SpatialFilter, SpatialTr
 use glam::Vec3;
 
 /// The paper's guiding field: one spatial tree whose cells hold an SD-tree
-/// cell and a guiding cut. See the [module docs](self).
+/// cell and a guiding cut. See the module docs.
 ///
 /// `H` is the light hierarchy, held as the renderer chooses: owned
 /// (`GuidingField<LightTree>`), shared with the scene
@@ -168,7 +168,7 @@ impl<H: LightHierarchy> GuidingField<H> {
     /// collected nothing is kept), then PPG's spatial rule: cells whose
     /// radiance-splat weight exceeds `c * sqrt(2^k)` split, recursively,
     /// within [`SdTreeConfig::max_bytes`](crate::sd_tree::SdTreeConfig::max_bytes)
-    /// (counted as [`FieldMemory::capped`]), both children holding copies
+    /// (counted as `FieldMemory::capped`), both children holding copies
     /// of the quadtree, the weight halved, and the cut. Collected sums are
     /// zeroed. Returns what the spatial pass did.
     pub fn refine(&mut self) -> RefineOutcome {

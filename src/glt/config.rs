@@ -70,7 +70,7 @@ pub enum Prior {
     /// at every shading point (the paper).
     Power,
     /// Tree-by-importance from the root (the Estevez-Kulla / pbrt-v4 rule
-    /// of [`crate::ImportanceTreeSampler`], power where both children's
+    /// of `ImportanceTreeSampler`, power where both children's
     /// importance vanishes). The importance bound is conservative, so an
     /// emitter that can reach the point keeps a non-zero pmf. With
     /// [`Modulation::Importance`] and [`BelowCut::Importance`] the walk
@@ -125,16 +125,16 @@ pub struct CutConfig {
     /// "Defaults of the cut"). 0 gives the paper's behaviour (biased for
     /// delta lights the cut never learned).
     pub alpha: f64,
-    /// How to continue below the cut. Default [`BelowCut::Importance`].
+    /// How to continue below the cut. Default `BelowCut::Importance`.
     pub below_cut: BelowCut,
     /// Whether the cut's probabilities vary inside a cell. Default
-    /// [`Modulation::Importance`].
+    /// `Modulation::Importance`.
     pub modulation: Modulation,
     /// The prior component of the defensive mixture. Default
-    /// [`Prior::Importance`].
+    /// `Prior::Importance`.
     pub prior: Prior,
     /// How a newly split slot's weight is shared. Default
-    /// [`SplitPrior::Half`].
+    /// `SplitPrior::Half`.
     pub split_prior: SplitPrior,
     /// The scene's unbounded lights (distant and infinite, beside the
     /// emitters) and their prior probability `q` together. Each one's
@@ -148,7 +148,7 @@ pub struct CutConfig {
     /// whatever the thread count (48 bytes per sum instead of 8).
     pub accumulation: Accumulation,
     /// The fewest non-zero splats a cut rebuilds from. Below it,
-    /// [`CutRules::refine`](super::CutRules::refine) keeps the cut as
+    /// `CutRules::refine` keeps the cut as
     /// it is and lets its sums go on accumulating into the next iteration:
     /// a light splat is an unbiased estimate whatever distribution drew it,
     /// so sums from several iterations add up. Without this floor a cell
@@ -161,11 +161,11 @@ pub struct CutConfig {
     /// Learn each cut cluster's visibility: the fraction of its unshadowed
     /// contribution that arrives, from next-event records that carry both
     /// (`splat_visibility` of [`crate::glt::Glt`], its vertex, the field and
-    /// [`CutRules::splat_visibility`](super::CutRules::splat_visibility)),
+    /// `CutRules::splat_visibility`),
     /// shrunk towards what the cluster had before when it has few records
     /// and never below 1/64. It is the factor resampled light choice puts
     /// on its target ([`crate::LightSampler::visibility`],
-    /// [`crate::resampling`]); sampling by the cut itself does not read
+    /// `crate::resampling`); sampling by the cut itself does not read
     /// it. Costs 20 bytes per cut slot (the value and two sums; 100 with
     /// [`Accumulation::Deterministic`]). Default false.
     pub visibility: bool,
@@ -190,8 +190,8 @@ impl Default for CutConfig {
 
 impl CutConfig {
     /// This configuration with every importance-based rule on (the
-    /// default): [`Modulation::Importance`], [`BelowCut::Importance`] and
-    /// [`Prior::Importance`]: the learned cut follows the shading point
+    /// default): `Modulation::Importance`, `BelowCut::Importance` and
+    /// `Prior::Importance`: the learned cut follows the shading point
     /// inside its cell. It costs two importance evaluations per level of
     /// every walk and chooses lights better per sample; in the render
     /// example it wins at equal time too on a quiet machine
@@ -205,8 +205,8 @@ impl CutConfig {
         }
     }
 
-    /// This configuration with the paper's rules: [`Modulation::None`],
-    /// [`BelowCut::Power`] and [`Prior::Power`]. One learned distribution
+    /// This configuration with the paper's rules: `Modulation::None`,
+    /// `BelowCut::Power` and `Prior::Power`. One learned distribution
     /// per cell, continued below the cut by subtree power, independent of
     /// the shading point: the cheapest walk (one table read per level) and
     /// the configuration to compare against the paper with.
@@ -220,8 +220,8 @@ impl CutConfig {
     }
 
     /// Whether any rule evaluates the importance of light-tree nodes
-    /// ([`Modulation::Importance`], [`BelowCut::Importance`],
-    /// [`Prior::Importance`]).
+    /// (`Modulation::Importance`, `BelowCut::Importance`,
+    /// `Prior::Importance`).
     pub fn uses_importance(&self) -> bool {
         self.modulation == Modulation::Importance
             || self.below_cut == BelowCut::Importance

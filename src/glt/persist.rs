@@ -240,7 +240,7 @@ impl GuidingCut {
 
 impl<H: LightHierarchy> Glt<H> {
     /// The learned state as bytes: a header, the light hierarchy's
-    /// [`fingerprint`](crate::persist::fingerprint), the configuration, the
+    /// `fingerprint`, the configuration, the
     /// iteration, the drop counts and every cell (cut, sums, counts).
     /// Accumulating sums are included, so a saved GLT can be merged or go
     /// on learning.

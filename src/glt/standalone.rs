@@ -112,7 +112,7 @@ impl GltMemory {
 
 /// The Guiding Light Tree over its own spatial tree: one learned cut per
 /// cell of PPG's binary tree over the scene, sampled by the GLT's sampling
-/// rule (see `sampling.rs` and [`GuidingCut`](super::GuidingCut)).
+/// rule (see `sampling.rs` and `GuidingCut`).
 ///
 /// Per iteration a renderer locates each path vertex once
 /// ([`Glt::vertex`]), samples lights and records what each sample found
@@ -194,14 +194,14 @@ impl<H: LightHierarchy> Glt<H> {
     ///
     /// A cell takes part once it holds 3/2 of the splats that fell in it
     /// before its last refinement (any, before its first; see
-    /// [`GltCell`]); the others
+    /// `GltCell`); the others
     /// keep accumulating. A cell that takes part splits while its count is
     /// above `c sqrt(2^g)` (`c` the spatial threshold, `g` the refinements
     /// it took part in, a half taken to have half its parent's splats: PPG's
     /// rule, with the cell's own clock); both halves get a copy of the cut
     /// and its sums, and each the confidence of its share of the records
-    /// ([`GuidingCut::confidence`](super::GuidingCut::confidence)). Then its cut is rebuilt from its sums
-    /// ([`CutRules::refine`]; a cut that collected nothing keeps its
+    /// (`GuidingCut::confidence`). Then its cut is rebuilt from its sums
+    /// (`CutRules::refine`; a cut that collected nothing keeps its
     /// distribution) within the memory budget. A renderer that refines
     /// after every iteration of PPG's doubling schedule makes every cell
     /// take part every time; one that renders tile by tile may refine

@@ -106,7 +106,7 @@ pub trait LightSampler {
 
     /// What the sampler learned of `light`'s visibility at `ctx`: the
     /// fraction of its unshadowed contribution that arrives, in
-    /// `[1/64, 1]`. Resampled light choice ([`crate::resampling`]) puts it
+    /// `[1/64, 1]`. Resampled light choice (`crate::resampling`) puts it
     /// on its target. 1 for samplers that learn none (the default), and
     /// for the GLT unless [`crate::glt::CutConfig::visibility`] is on.
     fn visibility(&self, _ctx: &ShadingContext, _light: LightId) -> f32 {

@@ -12,7 +12,7 @@ use crate::math::{Descent, Side};
 /// the renderer's own order (see [`LightId`] for the mapping).
 ///
 /// `probability` is the share they get together, equally split: the fixed
-/// probability of choosing one for [`WithUnbounded`], the prior (the
+/// probability of choosing one for `WithUnbounded`, the prior (the
 /// defensive floor, mixed in by `alpha`) for the GLT, which learns each
 /// one's share per cell. pbrt-v4's BVH light sampler uses
 /// `count / (count + 1)`.

@@ -7,7 +7,7 @@ use crate::math::Aabb;
 use alloc::vec::Vec;
 
 /// The global light tree: a binary BVH over the scene's emitters, one emitter
-/// per leaf, 32 bytes per node (see [`LightNode`]) plus 4 bytes per emitter
+/// per leaf, 32 bytes per node (see `LightNode`) plus 4 bytes per emitter
 /// for its leaf.
 ///
 /// Built once from an [`Emitters`] list; immutable and `Sync` afterwards.

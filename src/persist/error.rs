@@ -24,7 +24,7 @@ pub enum LoadError {
     },
     /// Holds another kind of structure than the one asked for.
     WrongKind {
-        /// The kind asked for ([`Kind`](super::Kind) as a number).
+        /// The kind asked for (`Kind` as a number).
         expected: u32,
         /// The kind in the header.
         found: u32,

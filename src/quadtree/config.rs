@@ -26,7 +26,7 @@ pub(crate) const DEFAULT_UNIFORM_FRACTION: f32 = 1.0e-3;
 /// direction positive in `f32`.
 pub(crate) const MIN_UNIFORM_FRACTION: f32 = 1.0e-6;
 
-/// How [`DirectionalTree::refine`](super::DirectionalTree::refine) reshapes
+/// How `DirectionalTree::refine` reshapes
 /// the building copy.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct QuadtreeConfig {
@@ -62,7 +62,7 @@ impl QuadtreeConfig {
     pub const MIN_RHO: f32 = MIN_RHO;
 
     /// Checks `rho` in `[MIN_RHO, 1]` and `max_depth` in `1..=MAX_DEPTH`.
-    /// A [`DirectionalTree`](super::DirectionalTree) refined with an
+    /// A `DirectionalTree` refined with an
     /// unchecked configuration uses the nearest valid values.
     pub fn validate(&self) -> Result<(), crate::error::ConfigError> {
         let rho = f64::from(self.rho);

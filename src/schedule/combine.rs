@@ -45,7 +45,7 @@ impl InverseVarianceCombiner {
         });
     }
 
-    /// Adds an iteration from its [`PassStats`] (mean image, unbiased
+    /// Adds an iteration from its `PassStats` (mean image, unbiased
     /// variance, pass count).
     pub fn push_stats(&mut self, stats: &PassStats) {
         self.push(Entry {

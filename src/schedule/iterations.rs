@@ -82,7 +82,7 @@ pub fn next_iteration_by_time(
 }
 
 /// The iterations of a budget of passes, in order (an iterator of
-/// [`Iteration`]).
+/// `Iteration`).
 #[derive(Clone, Debug)]
 pub struct Iterations {
     remaining: u64,

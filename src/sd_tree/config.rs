@@ -27,7 +27,7 @@ pub struct SdTreeConfig {
     /// bit-identical whatever the thread count.
     pub accumulation: Accumulation,
     /// Optional cap on the SD-tree's bytes (spatial tree plus every cell's
-    /// quadtrees and sums, as [`SdTreeMemory::total`](super::SdTreeMemory::total)
+    /// quadtrees and sums, as `SdTreeMemory::total`
     /// counts them) after every refine. The quadtrees are refined first,
     /// their growth scaled down by one factor for all cells when it would
     /// not fit (each rebuilt with a coarser `rho` until it has at most that
@@ -42,7 +42,7 @@ pub struct SdTreeConfig {
     /// `[0, 1]`.
     pub bsdf_fraction: f32,
     /// Learn `s` per cell (Müller 2019), see the
-    /// [module docs](super#the-learned-bsdf-sampling-fraction).
+    /// module docs.
     pub learn_bsdf_fraction: bool,
     /// Adam steps per refinement for the learned fraction, at most one per
     /// recorded sample of the cell. Default 256.

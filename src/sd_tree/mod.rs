@@ -132,7 +132,7 @@ use crate::error::Error;
 use crate::math::Aabb;
 use crate::spatial::BinaryTree;
 
-/// Practical Path Guiding's SD-tree. See the [module docs](self).
+/// Practical Path Guiding's SD-tree. See the module docs.
 #[derive(Clone, Debug)]
 pub struct SdTree {
     tree: BinaryTree<SdCell>,
