@@ -229,6 +229,50 @@ mod tests {
         node(Aabb::from_point(p), LightCone::SPHERE, power)
     }
 
+    /// The documented edges, each against what it must equal: no
+    /// importance at a non-finite point (even from a cluster that emits
+    /// everywhere, whose bound would otherwise not look at the point), a
+    /// cone axis of any length or none at all (zero or infinite: every
+    /// direction, as an omnidirectional cluster), a normal of any length or
+    /// a zero one (no normal).
+    #[test]
+    fn degenerate_inputs_are_handled_as_documented() {
+        let at = ShadingContext::at(Vec3::new(0.3, -8.0, 0.5));
+        let b = Aabb::new(Vec3::new(-0.5, 0.0, -0.5), Vec3::new(0.5, 0.2, 0.5));
+        let omni = importance(&at, &node(b, LightCone::SPHERE, 3.0));
+        assert!(omni > 0.0);
+        for p in [Vec3::NAN, Vec3::new(f32::INFINITY, 0.0, 0.0)] {
+            let bad = ShadingContext::at(p);
+            assert_eq!(importance(&bad, &node(b, LightCone::SPHERE, 3.0)), 0.0);
+            assert_eq!(importance(&bad, &point(Vec3::ZERO, 3.0)), 0.0);
+        }
+        let cone = |axis: Vec3| LightCone {
+            axis,
+            cos_theta_o: 0.99,
+            cos_theta_e: 0.0,
+        };
+        for axis in [Vec3::ZERO, Vec3::new(f32::INFINITY, 0.0, 0.0)] {
+            assert_eq!(importance(&at, &node(b, cone(axis), 3.0)), omni);
+        }
+        // An axis the point lies outside the normal cone of.
+        let axis = Vec3::new(1.0, -1.0, 0.0).normalize();
+        let unit = importance(&at, &node(b, cone(axis), 3.0));
+        let long = importance(&at, &node(b, cone(3.0 * axis), 3.0));
+        assert!(unit > 0.0 && unit < omni, "{unit} {omni}");
+        assert!((long - unit).abs() <= 1e-6 * unit, "{long} {unit}");
+        let with = |n: Option<Vec3>| {
+            let ctx = ShadingContext {
+                position: at.position,
+                normal: n,
+            };
+            importance(&ctx, &node(b, LightCone::SPHERE, 3.0))
+        };
+        let tilted = Vec3::new(1.0, 0.2, 0.0);
+        assert_eq!(with(Some(Vec3::ZERO)), with(None));
+        let (n1, n2) = (with(Some(tilted.normalize())), with(Some(2.0 * tilted)));
+        assert!(n1 < omni && (n1 - n2).abs() <= 1e-6 * n1, "{n1} {n2}");
+    }
+
     #[test]
     fn point_light_is_inverse_square() {
         let ctx = ShadingContext::at(Vec3::ZERO);
