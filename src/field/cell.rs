@@ -83,3 +83,10 @@ impl AsRef<GuidingCut> for FieldCell {
         &self.cut
     }
 }
+
+impl AsRef<OctantSplats> for FieldCell {
+    #[inline]
+    fn as_ref(&self) -> &OctantSplats {
+        &self.octants
+    }
+}

@@ -2,15 +2,14 @@
 //! guiding and its light choice.
 
 use super::{FieldCell, GuidingField};
-use crate::dropped::DropReason;
+use crate::dropped::{DropCounters, DropReason};
 use crate::emitter::ShadingContext;
-use crate::glt::{LightCells, LightVertex, octant_of};
+use crate::glt::{LightCells, LightVertex};
 use crate::light_sampler::LightId;
 use crate::light_tree::LightHierarchy;
-use crate::math::Aabb;
 use crate::record::RecordOutcome;
 use crate::sd_tree::{DirectionVertex, RadianceCells};
-use crate::spatial::{CellId, SpatialTree};
+use crate::spatial::{Located, SpatialTree};
 use glam::Vec3;
 
 /// A path vertex located in a [`GuidingField`] ([`GuidingField::vertex`]):
@@ -47,42 +46,20 @@ impl<H: LightHierarchy> GuidingField<H> {
 
 impl<H: LightHierarchy> RadianceCells for GuidingField<H> {
     #[inline]
-    fn record_radiance(
-        &self,
-        at: (Vec3, (CellId, Aabb)),
-        dir: Vec3,
-        radiance: f32,
-        pdf: f32,
-    ) -> RecordOutcome {
-        let c = &self.sd.config;
-        let filters = (c.spatial_filter, c.directional_filter);
-        self.sd
-            .record_radiance(&self.cells, at, dir, radiance, pdf, filters)
+    fn record_radiance(&self, at: Located, dir: Vec3, radiance: f32, pdf: f32) -> RecordOutcome {
+        self.sd.record_radiance(&self.cells, at, dir, radiance, pdf)
     }
 }
 
 impl<H: LightHierarchy> LightCells for GuidingField<H> {
     #[inline]
-    fn record_light(
-        &self,
-        at: (Vec3, (CellId, Aabb)),
-        light: LightId,
-        value: f32,
-    ) -> RecordOutcome {
-        let octant = octant_of(at.0, &at.1.1);
-        let outcome =
-            self.guide
-                .record_spread(&self.cells, at, light, value, self.light_filter, |cell| {
-                    cell.octants.count(octant);
-                });
-        if outcome == RecordOutcome::Dropped {
-            self.count_dropped();
-        }
-        outcome
+    fn record_light(&self, at: Located, light: LightId, value: f32) -> RecordOutcome {
+        let cells = (&self.cells, self.light_filter, &self.sd.dropped);
+        self.guide.record_in_cells(cells, at, light, value)
     }
 
     #[inline]
-    fn count_dropped(&self) {
-        self.sd.dropped.count(DropReason::Light);
+    fn dropped(&self) -> &DropCounters {
+        &self.sd.dropped
     }
 }

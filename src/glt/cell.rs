@@ -75,6 +75,13 @@ impl AsRef<GuidingCut> for GltCell {
     }
 }
 
+impl AsRef<OctantSplats> for GltCell {
+    #[inline]
+    fn as_ref(&self) -> &OctantSplats {
+        &self.octants
+    }
+}
+
 impl GltCell {
     /// A cell with `cut`, nothing recorded.
     pub(super) fn new(cut: GuidingCut) -> Self {

@@ -58,7 +58,7 @@ pub use config::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
 pub use cut::{CutError, CutMemory, GuidingCut};
 pub use cut_node::{CutNode, Slot};
 pub use cut_rules::CutRules;
-pub(crate) use octants::{OctantSplats, octant_of};
+pub(crate) use octants::OctantSplats;
 pub use standalone::{Glt, GltConfig, GltMemory};
 pub(crate) use vertex::LightCells;
 pub use vertex::LightVertex;

@@ -7,7 +7,6 @@ use super::config::CutConfig;
 use super::cut::CutMemory;
 use super::cut_node::CutNode;
 use super::cut_rules::CutRules;
-use super::octants::octant_of;
 use super::vertex::{LightCells, LightVertex};
 use crate::dropped::{DropCounters, DropReason, DroppedRecords};
 use crate::emitter::ShadingContext;
@@ -16,7 +15,7 @@ use crate::light_sampler::LightId;
 use crate::light_tree::LightHierarchy;
 use crate::math::Aabb;
 use crate::record::RecordOutcome;
-use crate::spatial::{BinaryTree, CellId, RefineOutcome, SpatialFilter, SpatialTree};
+use crate::spatial::{BinaryTree, CellId, Located, RefineOutcome, SpatialFilter, SpatialTree};
 use crate::spatial::{Growth, content_scale};
 use glam::Vec3;
 
@@ -293,30 +292,14 @@ impl<H: LightHierarchy> Glt<H> {
 
 impl<H: LightHierarchy> LightCells for Glt<H> {
     #[inline]
-    fn record_light(
-        &self,
-        at: (Vec3, (CellId, Aabb)),
-        light: LightId,
-        value: f32,
-    ) -> RecordOutcome {
-        let octant = octant_of(at.0, &at.1.1);
-        let outcome = self.guide.record_spread(
-            &self.spatial,
-            at,
-            light,
-            value,
-            self.config.light_filter,
-            |cell| cell.octants.count(octant),
-        );
-        if outcome == RecordOutcome::Dropped {
-            self.count_dropped();
-        }
-        outcome
+    fn record_light(&self, at: Located, light: LightId, value: f32) -> RecordOutcome {
+        let cells = (&self.spatial, self.config.light_filter, &self.dropped);
+        self.guide.record_in_cells(cells, at, light, value)
     }
 
     #[inline]
-    fn count_dropped(&self) {
-        self.dropped.count(DropReason::Light);
+    fn dropped(&self) -> &DropCounters {
+        &self.dropped
     }
 }
 

@@ -4,26 +4,31 @@
 
 use super::cut::GuidingCut;
 use super::cut_rules::CutRules;
+use super::octants::{OctantSplats, octant_of};
+use crate::dropped::{DropCounters, DropReason};
 use crate::emitter::ShadingContext;
 use crate::light_sampler::{LightId, LightSample, LightSampler};
 use crate::light_tree::LightHierarchy;
 use crate::math::Aabb;
 use crate::record::RecordOutcome;
-use crate::spatial::{BinaryTree, CellId, SpatialFilter, SpatialTree, record_offset};
+use crate::spatial::{BinaryTree, CellId, Located, SpatialFilter, SpatialTree, record_offset};
 use glam::Vec3;
 
 /// Where a light vertex's records go: the cells of a [`Glt`](super::Glt)
 /// or of a [`GuidingField`](crate::field::GuidingField) (a stochastic filter may
 /// carry a record into a neighbouring cell), and their drop counter.
 pub(crate) trait LightCells {
-    /// The GLT's record of the estimate `value` for `light`, made at `p`
-    /// located at `at`, with the configured filter; counts a drop.
-    fn record_light(&self, at: (Vec3, (CellId, Aabb)), light: LightId, value: f32)
-    -> RecordOutcome;
+    /// The GLT's record of the estimate `value` for `light` made at a
+    /// located point, with the configured filter; counts a drop.
+    fn record_light(&self, at: Located, light: LightId, value: f32) -> RecordOutcome;
 
-    /// Counts one dropped light record.
-    fn count_dropped(&self);
+    /// The counters of dropped records.
+    fn dropped(&self) -> &DropCounters;
 }
+
+/// The cells light records spread over: a spatial tree of cells holding a
+/// cut and its per-octant counts, its light filter, and its drop counters.
+pub(crate) type Cells<'a, C> = (&'a BinaryTree<C>, SpatialFilter, &'a DropCounters);
 
 /// The salt of a light record's stochastic-box offset
 /// (`src/spatial/jitter.rs`): which light it is.
@@ -75,7 +80,7 @@ impl<'a, H: LightHierarchy> LightVertex<'a, H> {
     pub(crate) fn new(
         rules: &'a CutRules<H>,
         cut: &'a GuidingCut,
-        (p, at): (Vec3, (CellId, Aabb)),
+        (p, at): Located,
         cells: &'a dyn LightCells,
     ) -> Self {
         Self {
@@ -139,7 +144,7 @@ impl<'a, H: LightHierarchy> LightVertex<'a, H> {
             .splat_visibility(self.cut, light, shadowed, unshadowed);
         if outcome == RecordOutcome::Dropped {
             if let Some((cells, _)) = self.cells {
-                cells.count_dropped();
+                cells.dropped().count(DropReason::Light);
             }
         }
         outcome
@@ -160,37 +165,40 @@ impl<H: LightHierarchy> CutRules<H> {
     }
 
     /// Records the estimate `value` for `light` made at `p` (located at
-    /// `at` in `cells`) into the cuts of the cells that `filter` spreads
-    /// the point over (each cell's part `value * weight`), the stochastic
-    /// box's offset hashed from the record. `accepted` is called for every
-    /// cell whose cut took its part ([`RecordOutcome::Recorded`] or
-    /// [`RecordOutcome::Zero`]). The caller counts a
-    /// [`RecordOutcome::Dropped`] result, once per call. Shared by
+    /// `at` in `cells`) into the cuts of the cells that the cells' filter
+    /// spreads the point over (each cell's part `value * weight`), the
+    /// stochastic box's offset hashed from the record; every cell whose cut
+    /// took its part ([`RecordOutcome::Recorded`] or
+    /// [`RecordOutcome::Zero`]) counts it in the octant of its cell `p` lies
+    /// in. A [`RecordOutcome::Dropped`] result is counted once. Shared by
     /// [`Glt`](super::Glt) and the guiding field.
     #[inline]
-    pub(crate) fn record_spread<C: AsRef<GuidingCut>>(
+    pub(crate) fn record_in_cells<C: AsRef<GuidingCut> + AsRef<OctantSplats>>(
         &self,
-        cells: &BinaryTree<C>,
-        (p, at): (Vec3, (CellId, Aabb)),
+        (cells, filter, dropped): Cells<'_, C>,
+        (p, at): Located,
         light: LightId,
         value: f32,
-        filter: SpatialFilter,
-        accepted: impl Fn(&C),
     ) -> RecordOutcome {
+        let octant = octant_of(p, &at.1);
         let mut outcome = RecordOutcome::Zero;
         let jitter = || record_offset(p, light_salt(light));
         cells.spread_from(p, at, filter, jitter, |cell, weight| {
             let cell = cells.data(cell);
-            match self.splat_weighted_from(cell.as_ref(), p, weight, light, value * weight) {
+            let cut: &GuidingCut = cell.as_ref();
+            match self.splat_weighted_from(cut, p, weight, light, value * weight) {
                 RecordOutcome::Dropped => outcome = RecordOutcome::Dropped,
                 o => {
-                    accepted(cell);
+                    AsRef::<OctantSplats>::as_ref(cell).count(octant);
                     if o == RecordOutcome::Recorded && outcome != RecordOutcome::Dropped {
                         outcome = o;
                     }
                 }
             }
         });
+        if outcome == RecordOutcome::Dropped {
+            dropped.count(DropReason::Light);
+        }
         outcome
     }
 }

@@ -4,12 +4,9 @@ use super::SdCell;
 use super::state::SdState;
 use super::validate::splat_value;
 use crate::dropped::DropReason;
-use crate::math::Aabb;
 use crate::math::unit_direction;
-use crate::quadtree::DirectionalFilter;
 use crate::record::RecordOutcome;
-use crate::spatial::SpatialFilter;
-use crate::spatial::{BinaryTree, CellId, SpatialTree, direction_salt, record_offset};
+use crate::spatial::{BinaryTree, Located, SpatialTree, direction_salt, record_offset};
 use glam::Vec3;
 
 /// The value to record, or why the record is dropped (the first failing
@@ -22,20 +19,20 @@ fn check(dir: Vec3, radiance: f32, pdf: f32) -> Result<f32, DropReason> {
 
 impl SdState {
     /// PPG's record into the cells of `tree`: `radiance / pdf` along `dir`
-    /// from the point `p` located at `at`, spread by `filters` (see
+    /// from the point `p` located at `at`, spread by the configured filters
+    /// (see
     /// [`DirectionVertex::record_radiance`](super::DirectionVertex::record_radiance)).
     /// Invalid input is dropped and counted.
-    #[allow(clippy::too_many_arguments)]
     #[inline]
     pub(crate) fn record_radiance<C: AsRef<SdCell>>(
         &self,
         tree: &BinaryTree<C>,
-        (p, at): (Vec3, (CellId, Aabb)),
+        (p, at): Located,
         dir: Vec3,
         radiance: f32,
         pdf: f32,
-        filters: (SpatialFilter, DirectionalFilter),
     ) -> RecordOutcome {
+        let filters = (self.config.spatial_filter, self.config.directional_filter);
         let value = match check(dir, radiance, pdf) {
             Ok(v) => v,
             Err(reason) => {

@@ -5,38 +5,22 @@
 use super::state::SdState;
 use super::{SdCell, SdTree};
 use crate::emitter::ShadingContext;
-use crate::math::Aabb;
 use crate::record::RecordOutcome;
-use crate::spatial::{CellId, SpatialTree};
+use crate::spatial::{CellId, Located, SpatialTree};
 use glam::Vec3;
 
 /// Where a direction vertex's radiance records go: the cells of an
 /// [`SdTree`] or of a [`GuidingField`](crate::field::GuidingField) (the spatial
 /// filters may reach the neighbouring cells).
 pub(crate) trait RadianceCells {
-    /// PPG's record from `p`, located at `at`, with the configured filters.
-    fn record_radiance(
-        &self,
-        at: (Vec3, (CellId, Aabb)),
-        dir: Vec3,
-        radiance: f32,
-        pdf: f32,
-    ) -> RecordOutcome;
+    /// PPG's record from a located point, with the configured filters.
+    fn record_radiance(&self, at: Located, dir: Vec3, radiance: f32, pdf: f32) -> RecordOutcome;
 }
 
 impl RadianceCells for SdTree {
     #[inline]
-    fn record_radiance(
-        &self,
-        at: (Vec3, (CellId, Aabb)),
-        dir: Vec3,
-        radiance: f32,
-        pdf: f32,
-    ) -> RecordOutcome {
-        let c = &self.state.config;
-        let filters = (c.spatial_filter, c.directional_filter);
-        self.state
-            .record_radiance(&self.tree, at, dir, radiance, pdf, filters)
+    fn record_radiance(&self, at: Located, dir: Vec3, radiance: f32, pdf: f32) -> RecordOutcome {
+        self.state.record_radiance(&self.tree, at, dir, radiance, pdf)
     }
 }
 
@@ -57,16 +41,15 @@ impl RadianceCells for SdTree {
 pub struct DirectionVertex<'a> {
     state: &'a SdState,
     cell: &'a SdCell,
-    p: Vec3,
-    at: (CellId, Aabb),
+    at: Located,
     cells: &'a dyn RadianceCells,
 }
 
 impl core::fmt::Debug for DirectionVertex<'_> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.debug_struct("DirectionVertex")
-            .field("position", &self.p)
-            .field("cell", &self.at.0)
+            .field("position", &self.at.0)
+            .field("cell", &self.at.1.0)
             .finish_non_exhaustive()
     }
 }
@@ -74,31 +57,20 @@ impl core::fmt::Debug for DirectionVertex<'_> {
 impl<'a> DirectionVertex<'a> {
     /// The vertex at `p`, located at `at` in the spatial tree of `cells`.
     #[inline]
-    pub(crate) fn new(
-        state: &'a SdState,
-        cell: &'a SdCell,
-        (p, at): (Vec3, (CellId, Aabb)),
-        cells: &'a dyn RadianceCells,
-    ) -> Self {
-        Self {
-            state,
-            cell,
-            p,
-            at,
-            cells,
-        }
+    pub(crate) fn new(state: &'a SdState, cell: &'a SdCell, at: Located, cells: &'a dyn RadianceCells) -> Self {
+        Self { state, cell, at, cells }
     }
 
     /// The point this vertex was located from.
     #[inline]
     pub fn position(&self) -> Vec3 {
-        self.p
+        self.at.0
     }
 
     /// The located cell's number.
     #[inline]
     pub fn cell(&self) -> CellId {
-        self.at.0
+        self.at.1.0
     }
 
     /// The located cell's directional part (its quadtree and learned
@@ -150,8 +122,7 @@ impl<'a> DirectionVertex<'a> {
     /// `radiance / pdf` overflowing `f32`. `&self`: any number of threads.
     #[inline]
     pub fn record_radiance(&self, dir: Vec3, radiance: f32, pdf: f32) -> RecordOutcome {
-        self.cells
-            .record_radiance((self.p, self.at), dir, radiance, pdf)
+        self.cells.record_radiance(self.at, dir, radiance, pdf)
     }
 
     /// Reports one direction sample to the cell's BSDF-fraction learner:

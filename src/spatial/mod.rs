@@ -50,6 +50,9 @@ mod tree_trait;
 pub use binary_tree::BinaryTree;
 pub(crate) use budget::{Growth, content_scale};
 pub use cell_id::CellId;
+
+/// A point and where a spatial tree located it: the cell and its bounds.
+pub(crate) type Located = (glam::Vec3, (CellId, crate::math::Aabb));
 pub use filter::SpatialFilter;
 pub(crate) use jitter::{direction_salt, record_offset};
 pub use refine::RefineOutcome;
