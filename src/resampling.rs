@@ -25,7 +25,7 @@
 //! (`E[f(x) W] = integral of f` for `W = weight / p_l`, the unbiased
 //! contribution weight of resampled importance sampling). At `M = 1` the
 //! weight is exactly `1 / pmf`. Its variance for i.i.d. candidates has a
-//! closed form, which `examples/light_limit` computes
+//! closed form, which `examples/render/src/bin/light_limit` computes
 //! (`variance::resampled_parts`).
 //!
 //! Why the square root: the learned visibility `v` is the chance that a

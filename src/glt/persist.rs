@@ -326,7 +326,7 @@ impl<H: LightHierarchy> Glt<H> {
     /// nothing changes and this is `false`. In
     /// [`Accumulation::Deterministic`](crate::math::Accumulation::Deterministic)
     /// the merged state is bit for bit what one GLT recording all the
-    /// workers' records would hold (`tests/merge.rs`, `examples/farm.rs`).
+    /// workers' records would hold (`tests/merge.rs`, `examples/render/src/bin/farm.rs`).
     pub fn merge(&mut self, other: &Self) -> bool {
         let same = fingerprint(self.light_tree()) == fingerprint(other.light_tree())
             && self.config == other.config

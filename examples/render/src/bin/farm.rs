@@ -8,33 +8,10 @@
 //! final render with each.
 //!
 //! ```text
-//! cargo run --release --example farm -- --workers 4
+//! cargo run --release --bin farm -- --workers 4
 //! ```
 
-#![allow(dead_code)]
-
-#[path = "render/bvh.rs"]
-mod bvh;
-#[path = "render/camera.rs"]
-mod camera;
-#[path = "render/geometry.rs"]
-mod geometry;
-#[path = "render/integrator.rs"]
-mod integrator;
-#[path = "render/lights.rs"]
-mod lights;
-#[path = "render/materials.rs"]
-mod materials;
-#[path = "render/methods.rs"]
-mod methods;
-#[path = "render/rng.rs"]
-mod rng;
-#[path = "render/run.rs"]
-mod run;
-#[path = "render/scene.rs"]
-mod scene;
-#[path = "render/scenes/mod.rs"]
-mod scenes;
+use guiding_render::{integrator, methods, run, scene, scenes};
 
 use clap::Parser;
 use guiding::LightTree;

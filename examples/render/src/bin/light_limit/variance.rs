@@ -212,6 +212,7 @@ pub enum Proxy {
 /// `k == s` give the first term, the others the product of two
 /// expectations). At `m = 1` it is plain sampling by `pmf`. Every integral
 /// is over the same light samples as [`parts`].
+#[allow(dead_code)] // the closed form by name; the instrument calls `resampled_parts_with`
 pub fn resampled_parts(t: &PointTerms, pmf: &[f64], visibility: &[f64], m: usize) -> (f64, f64) {
     resampled_parts_with(t, pmf, visibility, m, Proxy::Candidate)
 }

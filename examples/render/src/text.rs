@@ -7,7 +7,7 @@ use ab_glyph::{Font, FontRef, GlyphId, PxScale, ScaleFont, point};
 use std::sync::OnceLock;
 
 /// The font file, compiled in.
-const DEJAVU_SANS: &[u8] = include_bytes!("fonts/DejaVuSans-subset.ttf");
+const DEJAVU_SANS: &[u8] = include_bytes!("../fonts/DejaVuSans-subset.ttf");
 
 /// The parsed font.
 fn font() -> &'static FontRef<'static> {

@@ -29,6 +29,8 @@ impl Sampler {
 
     /// A number in `[0, 1)` with 24 random bits.
     #[inline]
+    // A sampler's next number, not an iterator's next item.
+    #[allow(clippy::should_implement_trait)]
     pub fn next(&mut self) -> f32 {
         (self.rng.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0)
     }

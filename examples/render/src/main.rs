@@ -3,8 +3,8 @@
 //! guiding methods on code-generated analogues of the paper's scenes.
 //!
 //! ```text
-//! cargo run --release --example render                     # default job
-//! cargo run --release --example render -- --scene ring --method pt-uniform,ppg-glt --seconds 30 --json out.json
+//! cargo run --release --bin render                     # default job
+//! cargo run --release --bin render -- --scene ring --method pt-uniform,ppg-glt --seconds 30 --json out.json
 //! ```
 //!
 //! One concept per file: `cli` (flags), `scenes/` (scene generators),
@@ -15,29 +15,10 @@
 //! combination), `film` (EXR/PNG), `reference` (cache), `metrics`,
 //! `report` (JSON, table), `sheet` (comparison sheet).
 
-mod bvh;
-mod camera;
-mod cli;
-mod crossing;
-mod film;
-mod geometry;
-mod integrator;
-mod json;
-mod lights;
-mod materials;
-mod methods;
-mod metrics;
-mod plot;
-mod raster;
-mod reference;
-mod report;
-mod rng;
-mod run;
-mod scene;
-mod scenes;
-mod sheet;
-mod text;
-mod tiles;
+use guiding_render::{
+    cli, crossing, film, methods, metrics, plot, raster, reference, report, rng, run, scenes,
+    sheet, tiles,
+};
 
 use clap::Parser;
 use guiding::spatial::SpatialFilter;

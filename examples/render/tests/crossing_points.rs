@@ -2,15 +2,7 @@
 //! goes below its unguided counterpart's for good) are found where they
 //! are, on curves whose crossing is known.
 
-#[path = "../examples/render/crossing.rs"]
-#[allow(dead_code)]
-mod crossing;
-#[path = "../examples/render/json.rs"]
-#[allow(dead_code)]
-mod json;
-#[path = "../examples/render/report.rs"]
-#[allow(dead_code)]
-mod report;
+use guiding_render::{crossing, report};
 
 use crossing::{crossing, crossings};
 use report::{CurvePoint, Record};

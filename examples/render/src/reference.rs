@@ -28,7 +28,7 @@ pub struct Reference {
 /// Where references committed to the repository live: the default scene's
 /// at the default size, so a first run does not spend most of its time
 /// rendering one (`references/README.md` there says how each was made).
-pub const COMMITTED: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/render/references");
+pub const COMMITTED: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/references");
 
 /// The common stem of a reference's files in `dir`:
 /// `<dir>/<scene>-<w>x<h>-<method>-<hash>` (`.exr`, `-variance.exr`,

@@ -6,35 +6,13 @@
 
 #![allow(dead_code)]
 
-#[path = "../examples/render/bvh.rs"]
-mod bvh;
-#[path = "../examples/render/camera.rs"]
-mod camera;
-#[path = "../examples/render/geometry.rs"]
-mod geometry;
-#[path = "../examples/render/integrator.rs"]
-mod integrator;
-#[path = "../examples/render/lights.rs"]
-mod lights;
-#[path = "../examples/render/materials.rs"]
-mod materials;
-#[path = "../examples/render/methods.rs"]
-mod methods;
-#[path = "../examples/render/rng.rs"]
-mod rng;
-#[path = "../examples/render/run.rs"]
-mod run;
-#[path = "../examples/render/scene.rs"]
-mod scene;
-#[path = "../examples/render/scenes/mod.rs"]
-mod scenes;
-
-#[path = "../examples/light_limit/brute_force.rs"]
+#[path = "../src/bin/light_limit/brute_force.rs"]
 mod brute_force;
-#[path = "../examples/light_limit/shading_points.rs"]
+#[path = "../src/bin/light_limit/shading_points.rs"]
 mod shading_points;
-#[path = "../examples/light_limit/variance.rs"]
+#[path = "../src/bin/light_limit/variance.rs"]
 mod variance;
+use guiding_render::{geometry, lights, materials, rng, scene, scenes};
 
 use brute_force::PointTerms;
 

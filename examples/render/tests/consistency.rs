@@ -2,51 +2,11 @@
 //! method: per-method image means (whole image and quadrants) agree with an
 //! independent reference within their statistical error on `box`, on a small many-light scene (`ring`
 //! with 1,536 lights) and on `few-lights` (environment light). And the
-//! `embed` example runs and passes its own checks. And the reference
-//! committed for the default job belongs to the default scene as it is.
-//!
-//! The example's modules are compiled in here as they are (`#[path]`), so
-//! the test exercises exactly the code the example runs.
+//! reference committed for the default job belongs to the default scene as
+//! it is. It runs the `render` binary's own library, so it exercises
+//! exactly the code the binary runs.
 
-#![allow(dead_code)]
-
-#[path = "../examples/render/bvh.rs"]
-mod bvh;
-#[path = "../examples/render/camera.rs"]
-mod camera;
-#[path = "../examples/embed.rs"]
-mod embed;
-#[path = "../examples/render/film.rs"]
-mod film;
-#[path = "../examples/render/geometry.rs"]
-mod geometry;
-#[path = "../examples/render/integrator.rs"]
-mod integrator;
-#[path = "../examples/render/json.rs"]
-#[allow(dead_code)]
-mod json;
-#[path = "../examples/render/lights.rs"]
-mod lights;
-#[path = "../examples/render/materials.rs"]
-mod materials;
-#[path = "../examples/render/methods.rs"]
-mod methods;
-#[path = "../examples/render/metrics.rs"]
-mod metrics;
-#[path = "../examples/render/reference.rs"]
-mod reference;
-#[path = "../examples/render/report.rs"]
-mod report;
-#[path = "../examples/render/rng.rs"]
-mod rng;
-#[path = "../examples/render/run.rs"]
-mod run;
-#[path = "../examples/render/scene.rs"]
-mod scene;
-#[path = "../examples/render/scenes/mod.rs"]
-mod scenes;
-#[path = "../examples/render/tiles.rs"]
-mod tiles;
+use guiding_render::{lights, methods, metrics, reference, run, scene, scenes, tiles};
 
 use guiding::glt::{BelowCut, CutConfig};
 use methods::{GuideParams, Method};
@@ -274,11 +234,6 @@ fn environment_every_method_converges_to_the_same_image() {
     methods_agree("few-lights", 48, 36, 128);
 }
 
-#[test]
-fn embed_runs_and_its_checks_hold() {
-    assert!(embed::run());
-}
-
 /// The guided methods really learn: after a few training iterations their
 /// structures have grown well past the one-cell, uniform start (catches a
 /// method whose training records never arrive, which no mean would show).
@@ -496,7 +451,7 @@ fn the_committed_reference_is_the_default_scenes() {
         assert!(
             f.exists(),
             "no committed reference {} for the default scene {} (fingerprint {:016x}): render one \
-             with `cargo run --release --example render -- --reference-only --reference-spp 4096 \
+             with `cargo run --release --bin render -- --reference-only --reference-spp 4096 \
              --export-reference examples/render/references` (examples/render/references/README.md)",
             f.display(),
             scenes::DEFAULT,

@@ -2,26 +2,10 @@
 //! them, text drawn in the committed font, and records read back from the
 //! JSON the example writes, so committed plots can be redrawn from their
 //! data (`render --replot`).
-//!
-//! The example's modules are compiled in here as they are (`#[path]`).
 
-#![allow(dead_code)]
-
-#[path = "../examples/render/film.rs"]
-mod film;
-#[path = "../examples/render/json.rs"]
-mod json;
-#[path = "../examples/render/plot.rs"]
-mod plot;
-#[path = "../examples/render/raster.rs"]
-mod raster;
-#[path = "../examples/render/report.rs"]
-mod report;
-#[path = "../examples/render/text.rs"]
-mod text;
-
-use plot::{number, tick};
-use report::{CurvePoint, Record};
+use guiding_render::plot::{number, tick};
+use guiding_render::report::{CurvePoint, Record};
+use guiding_render::{plot, report, text};
 
 #[test]
 fn tick_labels_are_numbers_as_a_reader_writes_them() {

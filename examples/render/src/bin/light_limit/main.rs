@@ -13,9 +13,9 @@
 //! moment, from held-out samples that do not evaluate it).
 //!
 //! ```text
-//! cargo run --release --example light_limit -- --scene city,ring,torus --points 300 --json out/light_limit.json
-//! cargo run --release --example light_limit -- --scene city --glt "sigma=0.002" --glt "alpha=0.1 below=importance"
-//! cargo run --release --example light_limit -- --scene city --breakdown
+//! cargo run --release --bin light_limit -- --scene city,ring,torus --points 300 --json out/light_limit.json
+//! cargo run --release --bin light_limit -- --scene city --glt "sigma=0.002" --glt "alpha=0.1 below=importance"
+//! cargo run --release --bin light_limit -- --scene city --breakdown
 //! ```
 //!
 //! `--breakdown` prints, per GLT variant, where its variance comes from:
@@ -27,37 +27,13 @@
 //! files (`#[path]`), so the GLT measured is exactly the one `pt-glt`
 //! renders with.
 
-#![allow(dead_code)]
-
-#[path = "../render/bvh.rs"]
-mod bvh;
-#[path = "../render/camera.rs"]
-mod camera;
-#[path = "../render/geometry.rs"]
-mod geometry;
-#[path = "../render/integrator.rs"]
-mod integrator;
-#[path = "../render/lights.rs"]
-mod lights;
-#[path = "../render/materials.rs"]
-mod materials;
-#[path = "../render/methods.rs"]
-mod methods;
-#[path = "../render/rng.rs"]
-mod rng;
-#[path = "../render/run.rs"]
-mod run;
-#[path = "../render/scene.rs"]
-mod scene;
-#[path = "../render/scenes/mod.rs"]
-mod scenes;
-
 mod breakdown;
 mod brute_force;
 mod glt_variant;
 mod per_point_m;
 mod shading_points;
 mod variance;
+use guiding_render::{geometry, lights, materials, methods, rng, run, scene, scenes};
 
 use brute_force::PointTerms;
 use clap::Parser;
