@@ -17,7 +17,8 @@
 
 use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
 use glam::Vec3;
-use guiding::glt::{BelowCut, CutConfig, CutNode, CutRules, Glt, GltConfig, GuidingCut};
+use guiding::cut::{BelowCut, CutConfig, CutNode, CutRules, GuidingCut};
+use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::PowerTreeSampler;
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Aabb;

@@ -19,7 +19,8 @@
 //! noise of its own (only the training's).
 
 use glam::Vec3;
-use guiding::glt::{BelowCut, CutConfig, Glt, GltConfig, SplitPrior};
+use guiding::cut::{BelowCut, CutConfig, SplitPrior};
+use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Aabb;
 use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};

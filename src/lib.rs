@@ -39,7 +39,9 @@
 //! Each module (`src/`) only uses the ones above it: `math` (boxes, cones,
 //! the sphere map, the exact one-number descent, thread-safe sums),
 //! `emitter`, `light_tree`, `light_sampler`, `spatial` (PPG's binary
-//! tree), `quadtree` and `sd_tree`, `glt`, `field`, `schedule`, then for the
+//! tree), `quadtree` and `sd_tree`, `cut` (the learned cut, its sampling
+//! rule, records and refinement), `glt` and `field` (cuts in spatial
+//! trees), `schedule`, then for the
 //! integrator `strategy`, `path_recorder`, `mis`, `resampling`,
 //! `shared_guide`, and `persist` (saving, loading and merging what was
 //! learned).
@@ -48,12 +50,15 @@
 //!
 //! | what | file |
 //! | --- | --- |
-//! | the GLT's sampling rule and pmf | `src/glt/sampling.rs` |
+//! | the GLT's sampling rule and pmf | `src/cut/sampling.rs` |
+//! | a path vertex's light choice and records (`LightVertex`) | `src/cut/vertex.rs` |
+//! | a path vertex's directional guiding and records (`DirectionVertex`) | `src/sd_tree/vertex.rs` |
+//! | the GLT's cells refining on their own records | `src/glt/cell.rs`, `src/glt/guiding_light_tree.rs` |
 //! | resampled light choice (candidates, reservoir, weight) | `src/resampling.rs` |
-//! | each cut cluster's learned visibility (the resampling target's factor) | `src/glt/visibility.rs` |
-//! | the light tree laid out for the GLT's walk | `src/glt/walk.rs` |
-//! | cut refinement (split / merge by sigma, `min_splats`) | `src/glt/refine.rs` |
-//! | the tables every cut reads (`CutRules`) | `src/glt/cut_rules.rs` |
+//! | each cut cluster's learned visibility (the resampling target's factor) | `src/cut/visibility.rs` |
+//! | the light tree laid out for the GLT's walk | `src/cut/walk.rs` |
+//! | cut refinement (split / merge by sigma, `min_splats`) | `src/cut/refine.rs` |
+//! | the tables every cut reads (`CutRules`) | `src/cut/cut_rules.rs` |
 //! | a path's radiance records | `src/path_recorder.rs` |
 //! | the save format and its checks | `src/persist/`, `docs/format.md` |
 //! | light-tree build heuristics | `src/light_tree/build.rs` |
@@ -125,6 +130,7 @@ macro_rules! layers {
 }
 
 layers! {
+    cut;
     dropped;
     emitter;
     error;
@@ -159,8 +165,9 @@ pub use math::{Aabb, Accumulation};
 pub use light_sampler::{LightId, LightSample, LightSampler, UnboundedLights};
 pub use strategy::Strategy;
 // The guides, their configurations and their vertices.
+pub use cut::{CutConfig, LightVertex};
 pub use field::{FieldConfig, FieldVertex, GuidingField};
-pub use glt::{CutConfig, Glt, GltConfig, LightVertex};
+pub use glt::{Glt, GltConfig};
 pub use quadtree::{DirectionalFilter, QuadtreeConfig};
 pub use sd_tree::{DirectionVertex, SdTree, SdTreeConfig};
 pub use spatial::{RefineOutcome, SpatialFilter};

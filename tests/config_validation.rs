@@ -4,8 +4,9 @@
 mod common;
 
 use common::{scene, two_rooms};
+use guiding::cut::{CutConfig, CutRules};
 use guiding::field::{FieldConfig, GuidingField};
-use guiding::glt::{CutConfig, CutRules, Glt, GltConfig};
+use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::quadtree::QuadtreeConfig;
 use guiding::sd_tree::{SdTree, SdTreeConfig};

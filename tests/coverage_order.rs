@@ -8,7 +8,8 @@ use common::{ByPosition, LightsAt};
 
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
-use guiding::glt::{CutConfig, CutRules, Glt, GltConfig, GuidingCut};
+use guiding::cut::{CutConfig, CutRules, GuidingCut};
+use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::spatial::SpatialTree;
 use guiding::{Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext};

@@ -10,7 +10,7 @@
 //! `f64`, so the comparison with `sigma * T` is exercised at equality.
 
 use glam::Vec3;
-use guiding::glt::{CutConfig, CutRules, GuidingCut};
+use guiding::cut::{CutConfig, CutRules, GuidingCut};
 use guiding::light_tree::BuildHeuristic;
 use guiding::{Emitter, LightHierarchy, LightId, LightTree};
 

@@ -17,8 +17,9 @@ use common::{ByPosition, DirectionsAt, LightsAt};
 
 use common::{Rand, Z_P_1E4, chi_square_z, scene, two_rooms, value};
 use glam::Vec3;
+use guiding::cut::CutConfig;
 use guiding::field::{FieldConfig, GuidingField};
-use guiding::glt::{CutConfig, Glt, GltConfig};
+use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::sd_tree::SdTreeConfig;
 use guiding::{

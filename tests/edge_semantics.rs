@@ -8,8 +8,9 @@ use common::{ByPosition, LightsAt};
 
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
+use guiding::cut::{CutConfig, CutRules};
 use guiding::field::{FieldConfig, GuidingField};
-use guiding::glt::{CutConfig, CutRules, Glt, GltConfig};
+use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::{
     ImportanceTreeSampler, PowerSampler, PowerTreeSampler, UniformSampler, WithUnbounded,
 };

@@ -5,8 +5,9 @@
 
 use glam::Vec3;
 use guiding::RecordOutcome;
+use guiding::cut::{BelowCut, CutConfig, CutRules, GuidingCut};
 use guiding::field::{FieldConfig, GuidingField};
-use guiding::glt::{BelowCut, CutConfig, CutRules, Glt, GltConfig, GuidingCut};
+use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::{Aabb, Accumulation, canonical_to_dir};
 use guiding::quadtree::UNIFORM_PDF;

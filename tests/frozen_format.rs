@@ -25,8 +25,9 @@ use common::{ByPosition, LightsAt};
 
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
+use guiding::cut::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
 use guiding::field::{FieldConfig, GuidingField};
-use guiding::glt::{BelowCut, CutConfig, Glt, GltConfig, Modulation, Prior, SplitPrior};
+use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::ImportanceTreeSampler;
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Accumulation;

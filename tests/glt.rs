@@ -5,7 +5,7 @@
 //! across 60 decades and at 1M lights, concurrency and memory.
 
 use glam::Vec3;
-use guiding::glt::{
+use guiding::cut::{
     BelowCut, CutConfig, CutNode, CutRules, GuidingCut, Modulation, Prior, Slot, SplitPrior,
 };
 use guiding::light_tree::{BuildHeuristic, EmitterPath, NodeBounds};

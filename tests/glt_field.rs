@@ -5,7 +5,8 @@
 
 use glam::Vec3;
 use guiding::RecordOutcome;
-use guiding::glt::{CutConfig, Glt, GltConfig, GltMemory};
+use guiding::cut::CutConfig;
+use guiding::glt::{Glt, GltConfig, GltMemory};
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Accumulation;
 use guiding::spatial::SpatialFilter;

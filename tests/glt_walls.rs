@@ -17,7 +17,8 @@ use common::{ByPosition, LightsAt};
 
 use common::Rand;
 use glam::Vec3;
-use guiding::glt::{CutConfig, Glt, GltConfig, Modulation};
+use guiding::cut::{CutConfig, Modulation};
+use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::PowerSampler;
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Aabb;

@@ -10,8 +10,9 @@ use common::{ByPosition, LightsAt};
 
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
+use guiding::cut::CutConfig;
 use guiding::field::{FieldConfig, GuidingField};
-use guiding::glt::{CutConfig, Glt, GltConfig};
+use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::sd_tree::{SdTree, SdTreeConfig};
 use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};

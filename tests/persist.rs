@@ -8,7 +8,8 @@ use common::{ByPosition, LightsAt};
 
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
-use guiding::glt::{CutConfig, Glt, GltConfig};
+use guiding::cut::CutConfig;
+use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Accumulation;
 use guiding::{

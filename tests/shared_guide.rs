@@ -9,7 +9,8 @@ use common::LightsAt;
 
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
-use guiding::glt::{CutConfig, Glt, GltConfig};
+use guiding::cut::CutConfig;
+use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Accumulation;
 use guiding::shared_guide::SharedGuide;

@@ -6,8 +6,9 @@ mod common;
 
 use common::{LightsAt, scene, two_rooms};
 use glam::Vec3;
+use guiding::cut::CutConfig;
 use guiding::field::{FieldConfig, GuidingField};
-use guiding::glt::{CutConfig, Glt, GltConfig};
+use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::{DroppedRecords, LightId, LightTree, RecordOutcome, ShadingContext};
 

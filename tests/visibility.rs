@@ -11,7 +11,8 @@ use guiding::RecordOutcome;
 
 use common::{Rand, scene, two_rooms, unshadowed, value};
 use glam::Vec3;
-use guiding::glt::{CutConfig, Glt, GltConfig};
+use guiding::cut::CutConfig;
+use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::resampling::{Evaluated, resample};
 use guiding::{LightId, LightSampler, LightTree, ShadingContext};
@@ -286,10 +287,10 @@ fn sampling_with_visibility_equals_sampling_then_visibility() {
 fn the_learned_visibility_is_the_shrunk_ratio() {
     let one = [guiding::Emitter::point(Vec3::ZERO, 1.0)];
     let tree = LightTree::build(one.as_slice(), BuildHeuristic::Sarh).unwrap();
-    let guide = guiding::glt::CutRules::new(&tree, learning_visibility()).unwrap();
+    let guide = guiding::cut::CutRules::new(&tree, learning_visibility()).unwrap();
     let mut cut = guide.new_cut();
     let l = LightId::Emitter(0);
-    let round = |records: &[(f32, f32)], cut: &mut guiding::glt::GuidingCut| {
+    let round = |records: &[(f32, f32)], cut: &mut guiding::cut::GuidingCut| {
         guide.splat(cut, l, 1.0);
         for &(s, u) in records {
             assert_eq!(
@@ -319,9 +320,9 @@ fn the_learned_visibility_is_the_shrunk_ratio() {
 #[test]
 fn a_coarser_cut_keeps_what_its_finer_slots_learned() {
     let tree = row_of_lights();
-    let guide = guiding::glt::CutRules::new(&tree, learning_visibility()).unwrap();
+    let guide = guiding::cut::CutRules::new(&tree, learning_visibility()).unwrap();
     let mut cut = guide.new_cut();
-    let round = |lit: std::ops::Range<u32>, cut: &mut guiding::glt::GuidingCut| {
+    let round = |lit: std::ops::Range<u32>, cut: &mut guiding::cut::GuidingCut| {
         for e in lit {
             let l = LightId::Emitter(e);
             for _ in 0..8 {
@@ -359,13 +360,13 @@ fn a_coarser_cut_keeps_what_its_finer_slots_learned() {
 #[test]
 fn a_coarser_slot_weighs_its_old_slots_by_their_records() {
     let tree = row_of_lights();
-    let guide = guiding::glt::CutRules::new(&tree, learning_visibility()).unwrap();
+    let guide = guiding::cut::CutRules::new(&tree, learning_visibility()).unwrap();
     let mut cut = guide.new_cut();
     // Lights 0-3 hidden, 4-15 seen; `splat` says which lights the cut
     // resolves, `records` which send visibility records.
     let round = |splat: std::ops::Range<u32>,
                  records: std::ops::Range<u32>,
-                 cut: &mut guiding::glt::GuidingCut| {
+                 cut: &mut guiding::cut::GuidingCut| {
         for e in splat {
             guide.splat(cut, LightId::Emitter(e), 100.0);
         }

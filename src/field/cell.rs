@@ -1,6 +1,6 @@
 //! What one cell of the guiding field holds.
 
-use crate::glt::{GuidingCut, OctantSplats};
+use crate::cut::{GuidingCut, OctantSplats};
 use crate::sd_tree::SdCell;
 
 /// One cell of a [`GuidingField`](super::GuidingField): an SD-tree cell

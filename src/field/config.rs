@@ -1,6 +1,6 @@
 //! Parameters of the guiding field.
 
-use crate::glt::CutConfig;
+use crate::cut::CutConfig;
 use crate::math::Accumulation;
 use crate::sd_tree::SdTreeConfig;
 use crate::spatial::SpatialFilter;

@@ -1,7 +1,7 @@
 //! How much memory the guiding field uses, per structure.
 
 use super::GuidingField;
-use crate::glt::{CutMemory, CutNode};
+use crate::cut::{CutMemory, CutNode};
 use crate::light_tree::LightHierarchy;
 use crate::quadtree::NODE_BYTES;
 use crate::sd_tree::SdTreeMemory;
@@ -18,7 +18,7 @@ pub struct FieldMemory {
     /// The cuts together. Their `inline_bytes` are already in
     /// `sd.spatial_bytes` and are not added again in the totals.
     pub cuts: CutMemory,
-    /// The [`CutRules`](crate::glt::CutRules)'s split table, shared
+    /// The [`CutRules`](crate::cut::CutRules)'s split table, shared
     /// by all cells: split and walk tables, 12 bytes per light-tree node
     /// (plus 8).
     pub shared_bytes: usize,

@@ -115,7 +115,7 @@ pub use vertex::FieldVertex;
 
 use crate::dropped::DroppedRecords;
 use crate::error::Error;
-use crate::glt::CutRules;
+use crate::cut::CutRules;
 use crate::light_tree::LightHierarchy;
 use crate::math::Aabb;
 use crate::sd_tree::SdState;

@@ -2,7 +2,7 @@
 //! statistics.
 
 use super::{FieldCell, GuidingField};
-use crate::glt::{CutConfig, CutRules, GuidingCut, OctantSplats};
+use crate::cut::{CutConfig, CutRules, GuidingCut, OctantSplats};
 use crate::light_tree::LightHierarchy;
 use crate::persist::{
     FILTERS, Kind, LoadError, Reader, Writer, config_error, fingerprint, read_fingerprint, tag,

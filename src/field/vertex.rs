@@ -4,7 +4,7 @@
 use super::{FieldCell, GuidingField};
 use crate::dropped::{DropCounters, DropReason};
 use crate::emitter::ShadingContext;
-use crate::glt::{LightCells, LightVertex};
+use crate::cut::{LightCells, LightVertex};
 use crate::light_sampler::LightId;
 use crate::light_tree::LightHierarchy;
 use crate::record::RecordOutcome;

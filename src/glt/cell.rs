@@ -18,8 +18,8 @@
 //! ([`GuidingCut::confidence`]), down to the prior for a half the records
 //! never reached, until it refines on records of its own.
 
-use super::cut::GuidingCut;
-use super::octants::OctantSplats;
+use crate::cut::GuidingCut;
+use crate::cut::OctantSplats;
 use crate::spatial::split_threshold;
 
 /// A cell takes part in a refinement once it has collected
@@ -187,7 +187,7 @@ impl GltCell {
 mod tests {
     use super::*;
     use crate::emitter::Emitter;
-    use crate::glt::{CutConfig, CutRules};
+    use crate::cut::{CutConfig, CutRules};
     use crate::light_tree::{BuildHeuristic, LightTree};
     use glam::Vec3;
 

@@ -1,7 +1,7 @@
 //! The command line.
 
 use clap::Parser;
-use guiding::glt::{BelowCut, Modulation, Prior};
+use guiding::cut::{BelowCut, Modulation, Prior};
 use std::path::PathBuf;
 
 /// Renders the paper's scene analogues with every light-sampling and
@@ -54,12 +54,12 @@ pub struct Args {
     #[arg(long, default_value = "importance", value_parser = parse_below_cut)]
     pub below_cut: BelowCut,
     /// The fewest non-zero light splats a cut rebuilds from
-    /// (`guiding::glt::CutConfig::min_splats`; 0 = the paper's rule).
-    #[arg(long, default_value_t = guiding::glt::CutConfig::default().min_splats)]
+    /// (`guiding::cut::CutConfig::min_splats`; 0 = the paper's rule).
+    #[arg(long, default_value_t = guiding::cut::CutConfig::default().min_splats)]
     pub min_splats: u32,
     /// The GLT's defensive mixture weight alpha
-    /// (`guiding::glt::CutConfig::alpha`).
-    #[arg(long, default_value_t = guiding::glt::CutConfig::default().alpha)]
+    /// (`guiding::cut::CutConfig::alpha`).
+    #[arg(long, default_value_t = guiding::cut::CutConfig::default().alpha)]
     pub alpha: f64,
     /// Whether the GLT's cut probabilities vary inside a cell: `none` (the
     /// paper) or `importance` (learned factor x importance at the point;

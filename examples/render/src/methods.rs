@@ -3,8 +3,9 @@
 //! Light Tree and/or an SD-tree is trained.
 
 use crate::scene::Scene;
+use guiding::cut::{BelowCut, CutConfig, Modulation, Prior};
 use guiding::field::{FieldConfig, GuidingField};
-use guiding::glt::{BelowCut, CutConfig, Glt, GltConfig, Modulation, Prior};
+use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::{ImportanceTreeSampler, PowerSampler, UniformSampler, WithUnbounded};
 use guiding::sd_tree::{SdTree, SdTreeConfig};
 use guiding::spatial::SpatialFilter;

@@ -8,7 +8,7 @@
 
 use guiding_render::{lights, methods, metrics, reference, run, scene, scenes, tiles};
 
-use guiding::glt::{BelowCut, CutConfig};
+use guiding::cut::{BelowCut, CutConfig};
 use methods::{GuideParams, Method};
 use run::{Budget, Rendered, Settings};
 

@@ -15,8 +15,8 @@ use guiding_render::{integrator, methods, run, scene, scenes};
 
 use clap::Parser;
 use guiding::LightTree;
+use guiding::cut::CutConfig;
 use guiding::field::{FieldConfig, GuidingField};
-use guiding::glt::CutConfig;
 use guiding::math::Accumulation;
 use guiding::schedule::PassStats;
 use guiding::sd_tree::SdTreeConfig;

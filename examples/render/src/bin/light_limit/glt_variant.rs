@@ -1,7 +1,7 @@
 //! A GLT configuration to measure, from a `key=value` list.
 
 use crate::methods::GuideParams;
-use guiding::glt::{BelowCut, Modulation, Prior};
+use guiding::cut::{BelowCut, Modulation, Prior};
 use guiding::spatial::SpatialFilter;
 
 /// One GLT configuration and how long it trains.

@@ -1,113 +1,22 @@
 //! [`Glt`]: the Guiding Light Tree over its own spatial tree, for renderers
-//! without directional guiding. One [`GuidingCut`] per cell of PPG's spatial
+//! without directional guiding. One guiding cut per cell of PPG's spatial
 //! binary tree, each path vertex answered through its [`LightVertex`].
 
 use super::cell::GltCell;
-use super::config::CutConfig;
-use super::cut::CutMemory;
-use super::cut_node::CutNode;
-use super::cut_rules::CutRules;
-use super::vertex::{LightCells, LightVertex};
+use super::config::GltConfig;
+use super::memory::GltMemory;
+use crate::cut::CutRules;
+use crate::cut::{LightCells, LightVertex};
 use crate::dropped::{DropCounters, DropReason, DroppedRecords};
 use crate::emitter::ShadingContext;
-use crate::error::{ConfigError, Error};
+use crate::error::Error;
 use crate::light_sampler::LightId;
 use crate::light_tree::LightHierarchy;
 use crate::math::Aabb;
 use crate::record::RecordOutcome;
-use crate::spatial::{BinaryTree, CellId, Located, RefineOutcome, SpatialFilter, SpatialTree};
+use crate::spatial::{BinaryTree, CellId, Located, RefineOutcome, SpatialTree};
 use crate::spatial::{Growth, content_scale};
 use glam::Vec3;
-
-/// Parameters of a [`Glt`]: the cuts' and the spatial tree's.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct GltConfig {
-    /// How each cell's cut is refined and sampled.
-    pub cut: CutConfig,
-    /// PPG's spatial threshold `c`: a cell that takes part in its `g`-th
-    /// refinement (counted from 0, see [`Glt::refine`]) splits while its
-    /// number of splats exceeds `c * sqrt(2^g)`; each split halves the
-    /// count and gives both halves a copy of the cut and its statistics.
-    /// Default 250: a cut learns from far fewer records than a quadtree,
-    /// and finer cells paid off in every measurement (at 64 spp on `ring`
-    /// and `city`, relMSE 0.206 and 0.491 at 250, 0.218 and 0.524 at
-    /// 1000, 0.244 and 0.573 at PPG's 12,000, for 3x and 1.4x the memory
-    /// of 12,000; docs/experiments/tile-order.md). Memory grows with the
-    /// square root of the records (the threshold doubles every two
-    /// refinements); cap it with `max_bytes`.
-    pub spatial_threshold: f64,
-    /// Cap, in bytes, on the spatial tree plus the cells' cuts (their
-    /// nodes and sums) after every [`Glt::refine`]; `None` for none. Cell
-    /// splits are refused once it is reached (a split is charged the cut
-    /// it copies), then every cut's growth is scaled down by one factor:
-    /// each is rebuilt with a coarser `sigma` until it has at most that
-    /// share of the nodes it would have had (`src/spatial/budget.rs`). The
-    /// cap cannot shrink below what the cells hold whatever their nodes
-    /// (one sum each, the anchor sums).
-    pub max_bytes: Option<usize>,
-    /// The spatial filter of light records
-    /// ([`LightVertex::record_light`]). Default
-    /// [`SpatialFilter::Nearest`]: the estimate goes to the cell holding
-    /// the shading point. A jittering filter carries a splat into the
-    /// neighbouring cells, also through walls, where the light it saw may
-    /// be invisible; a dim room beside bright ones then learns its
-    /// neighbours' lights and samples worse than without learning
-    /// (`tests/glt_walls.rs`).
-    pub light_filter: SpatialFilter,
-}
-
-impl GltConfig {
-    /// Checks every field: the cut's ([`CutConfig::validate`]) and
-    /// `spatial_threshold` finite and positive (at 0 every cell would
-    /// split on every splat).
-    pub fn validate(&self) -> Result<(), ConfigError> {
-        self.cut.validate()?;
-        crate::error::positive("GltConfig::spatial_threshold", self.spatial_threshold)
-    }
-}
-
-impl Default for GltConfig {
-    fn default() -> Self {
-        Self {
-            cut: CutConfig::default(),
-            spatial_threshold: 250.0,
-            max_bytes: None,
-            light_filter: SpatialFilter::Nearest,
-        }
-    }
-}
-
-/// Bytes a [`Glt`] uses, by part.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct GltMemory {
-    /// Number of cells.
-    pub cells: usize,
-    /// The cuts together (nodes, sums, inline parts of the cells' cuts).
-    pub cuts: CutMemory,
-    /// The spatial tree's own storage: node words, per-cell bookkeeping and
-    /// the inline [`GltCell`] values (which include the cuts' inline parts,
-    /// so those are not added twice in [`GltMemory::total`]).
-    pub spatial_bytes: usize,
-    /// The [`CutRules`]'s split and walk tables, shared by all cells (12
-    /// bytes per light-tree node, plus 8).
-    pub shared_bytes: usize,
-}
-
-impl GltMemory {
-    /// Bytes of one cut node.
-    pub const BYTES_PER_CUT_NODE: usize = CutNode::BYTES;
-
-    /// Everything together.
-    pub fn total(&self) -> usize {
-        self.spatial_bytes + self.shared_bytes + self.cuts.node_bytes + self.cuts.sum_bytes
-    }
-
-    /// Average bytes per cell (cut nodes, sums and spatial share; the
-    /// shared table excluded).
-    pub fn bytes_per_cell(&self) -> f64 {
-        (self.total() - self.shared_bytes) as f64 / self.cells.max(1) as f64
-    }
-}
 
 /// The Guiding Light Tree over its own spatial tree: one learned cut per
 /// cell of PPG's binary tree over the scene, sampled by the GLT's sampling
@@ -303,11 +212,3 @@ impl<H: LightHierarchy> LightCells for Glt<H> {
     }
 }
 
-impl core::iter::Sum for CutMemory {
-    fn sum<I: Iterator<Item = Self>>(iter: I) -> Self {
-        iter.fold(Self::default(), |mut a, b| {
-            a += b;
-            a
-        })
-    }
-}

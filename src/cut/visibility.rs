@@ -25,7 +25,7 @@
 //! [`CutConfig::visibility`]: super::CutConfig::visibility
 //! [`CutConfig::min_splats`]: super::CutConfig::min_splats
 
-use super::cut::{GuidingCut, MIN_VISIBILITY, visibility_slots};
+use super::guiding_cut::{GuidingCut, MIN_VISIBILITY, visibility_slots};
 use super::cut_node::{CutNode, Slot};
 use super::cut_rules::CutRules;
 use crate::light_sampler::LightId;
@@ -238,7 +238,7 @@ fn below(old: &[CutNode], estimates: &[(f64, f64)], i: usize) -> f32 {
 mod tests {
     use super::*;
     use crate::emitter::Emitter;
-    use crate::glt::CutConfig;
+    use crate::cut::CutConfig;
     use crate::light_sampler::UnboundedLights;
     use crate::light_tree::{BuildHeuristic, LightTree};
     use glam::Vec3;

@@ -36,7 +36,7 @@
 //! equals [`CutRules::pmf_exact`] bit for bit, fallbacks included.
 
 use super::config::{BelowCut, CutConfig, Modulation, Prior};
-use super::cut::{GuidingCut, sum_count};
+use super::guiding_cut::{GuidingCut, sum_count};
 use super::cut_node::CutNode;
 use super::cut_rules::{CutRules, decode_split};
 use super::walk::WalkNode;
@@ -466,7 +466,7 @@ impl<H: LightHierarchy> CutRules<H> {
     /// their sum, `q` their configured prior together, `P_prior` the [`Prior`] rule from the root, `P_cut` the
     /// cut's learned probabilities, [`Modulation`] applied, down to the cut,
     /// then the [`BelowCut`] rule; the full description is at the top of
-    /// `src/glt/sampling.rs`). `None` when
+    /// `src/cut/sampling.rs`). `None` when
     /// nothing can be chosen or the pmf rounds to zero in `f32`.
     #[inline]
     pub fn sample(&self, cut: &GuidingCut, ctx: &ShadingContext, u: f32) -> Option<LightSample> {

@@ -2,7 +2,7 @@
 //! cut-based [`LightSampler`], serving every light query and record at a
 //! path vertex for the GLT and the guiding field alike.
 
-use super::cut::GuidingCut;
+use super::guiding_cut::GuidingCut;
 use super::cut_rules::CutRules;
 use super::octants::{OctantSplats, octant_of};
 use crate::dropped::{DropCounters, DropReason};
@@ -14,7 +14,7 @@ use crate::record::RecordOutcome;
 use crate::spatial::{BinaryTree, CellId, Located, SpatialFilter, SpatialTree, record_offset};
 use glam::Vec3;
 
-/// Where a light vertex's records go: the cells of a [`Glt`](super::Glt)
+/// Where a light vertex's records go: the cells of a [`Glt`](crate::glt::Glt)
 /// or of a [`GuidingField`](crate::field::GuidingField) (a stochastic filter may
 /// carry a record into a neighbouring cell), and their drop counter.
 pub(crate) trait LightCells {
@@ -41,10 +41,10 @@ pub(crate) fn light_salt(light: LightId) -> [u32; 3] {
 }
 
 /// A path vertex's light choice: the cut of the cell of a
-/// [`Glt`](super::Glt) ([`Glt::vertex`](super::Glt::vertex)) or of a
+/// [`Glt`](crate::glt::Glt) ([`Glt::vertex`](crate::glt::Glt::vertex)) or of a
 /// [`GuidingField`](crate::field::GuidingField)
 /// ([`FieldVertex::light`](crate::FieldVertex::light)) found by the one
-/// lookup, sampled by the GLT's sampling rule (`src/glt/sampling.rs`), and
+/// lookup, sampled by the GLT's sampling rule (`src/cut/sampling.rs`), and
 /// the records that teach it.
 ///
 /// It is a [`LightSampler`]: `sample` and `pmf` answer for the located
@@ -171,7 +171,7 @@ impl<H: LightHierarchy> CutRules<H> {
     /// took its part ([`RecordOutcome::Recorded`] or
     /// [`RecordOutcome::Zero`]) counts it in the octant of its cell `p` lies
     /// in. A [`RecordOutcome::Dropped`] result is counted once. Shared by
-    /// [`Glt`](super::Glt) and the guiding field.
+    /// [`Glt`](crate::glt::Glt) and the guiding field.
     #[inline]
     pub(crate) fn record_in_cells<C: AsRef<GuidingCut> + AsRef<OctantSplats>>(
         &self,

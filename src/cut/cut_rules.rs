@@ -2,7 +2,7 @@
 //! the GLT's walk reads, and the cut configuration.
 
 use super::config::CutConfig;
-use super::cut::GuidingCut;
+use super::guiding_cut::GuidingCut;
 use super::walk::WalkTable;
 use crate::error::ConfigError;
 use crate::light_sampler::ImportanceTable;
@@ -13,7 +13,7 @@ use alloc::vec::Vec;
 /// The rules every cell's cut is sampled, splatted and refined by, with the
 /// light-tree tables they read: the hierarchy, each inner node's power
 /// split precomputed (4 bytes per node), the tree re-laid out for sampling
-/// walks (8 bytes per node, see `src/glt/walk.rs`), the decoded importance
+/// walks (8 bytes per node, see `src/cut/walk.rs`), the decoded importance
 /// table when a rule uses importance (32 bytes per node), and the cut
 /// configuration. One per scene; every cell's [`GuidingCut`] is sampled
 /// ([`CutRules::sample`]), splatted ([`CutRules::splat`]) and refined

@@ -1,7 +1,7 @@
 //! Recording direct-light estimates into a cut's accumulating copy.
 
 use super::config::Modulation;
-use super::cut::GuidingCut;
+use super::guiding_cut::GuidingCut;
 use super::cut_rules::CutRules;
 use crate::light_sampler::LightId;
 use crate::light_tree::LightHierarchy;

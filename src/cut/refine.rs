@@ -2,7 +2,7 @@
 //! above `sigma`, end (merge) where it is not.
 
 use super::config::{Modulation, SplitPrior};
-use super::cut::{GuidingCut, sum_count};
+use super::guiding_cut::{GuidingCut, sum_count};
 use super::cut_node::{CutNode, Slot};
 use super::cut_rules::CutRules;
 use super::walk::WalkNode;
@@ -338,7 +338,7 @@ fn rebuild<H: LightHierarchy>(
 mod tests {
     use super::*;
     use crate::emitter::Emitter;
-    use crate::glt::CutConfig;
+    use crate::cut::CutConfig;
     use crate::light_sampler::{LightId, UnboundedLights};
     use crate::light_tree::{BuildHeuristic, LightTree};
     use glam::Vec3;

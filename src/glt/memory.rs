@@ -1,0 +1,44 @@
+//! [`GltMemory`]: the bytes a [`Glt`](super::Glt) uses, by part.
+
+use crate::cut::{CutMemory, CutNode};
+
+/// Bytes a [`Glt`](super::Glt) uses, by part.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GltMemory {
+    /// Number of cells.
+    pub cells: usize,
+    /// The cuts together (nodes, sums, inline parts of the cells' cuts).
+    pub cuts: CutMemory,
+    /// The spatial tree's own storage: node words, per-cell bookkeeping and
+    /// the inline [`GltCell`](super::GltCell) values (which include the cuts' inline parts,
+    /// so those are not added twice in [`GltMemory::total`]).
+    pub spatial_bytes: usize,
+    /// The [`CutRules`](crate::cut::CutRules)'s split and walk tables, shared by all cells (12
+    /// bytes per light-tree node, plus 8).
+    pub shared_bytes: usize,
+}
+
+impl GltMemory {
+    /// Bytes of one cut node.
+    pub const BYTES_PER_CUT_NODE: usize = CutNode::BYTES;
+
+    /// Everything together.
+    pub fn total(&self) -> usize {
+        self.spatial_bytes + self.shared_bytes + self.cuts.node_bytes + self.cuts.sum_bytes
+    }
+
+    /// Average bytes per cell (cut nodes, sums and spatial share; the
+    /// shared table excluded).
+    pub fn bytes_per_cell(&self) -> f64 {
+        (self.total() - self.shared_bytes) as f64 / self.cells.max(1) as f64
+    }
+}
+
+impl core::iter::Sum for CutMemory {
+    fn sum<I: Iterator<Item = Self>>(iter: I) -> Self {
+        iter.fold(Self::default(), |mut a, b| {
+            a += b;
+            a
+        })
+    }
+}
