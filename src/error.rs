@@ -17,6 +17,14 @@ pub struct ConfigError {
     pub expected: &'static str,
 }
 
+impl ConfigError {
+    /// This error as a load error at `offset` of a saved buffer (a saved
+    /// configuration that does not validate).
+    pub(crate) fn at(self, offset: usize) -> crate::persist::LoadError {
+        crate::persist::Reader::invalid(self.field, offset)
+    }
+}
+
 impl core::fmt::Display for ConfigError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         write!(

@@ -36,15 +36,16 @@
 //!
 //! ## Layers
 //!
-//! Each module (`src/`) only uses the ones above it: `math` (boxes, cones,
-//! the sphere map, the exact one-number descent, thread-safe sums),
-//! `emitter`, `light_tree`, `light_sampler`, `spatial` (PPG's binary
-//! tree), `quadtree` and `sd_tree`, `cut` (the learned cut, its sampling
-//! rule, records and refinement), `glt` and `field` (cuts in spatial
-//! trees), `schedule`, then for the
-//! integrator `strategy`, `path_recorder`, `mis`, `resampling`,
-//! `shared_guide`, and `persist` (saving, loading and merging what was
-//! learned).
+//! Each module (`src/`) only uses the ones before it: `persist` (the save
+//! format's bytes, header and checks; it uses no other module, each
+//! structure saves itself with it), `math` (boxes, cones, the sphere map,
+//! the exact one-number descent, thread-safe sums), `emitter`,
+//! `light_tree`, `spatial` (PPG's binary tree), `error`, `record` and
+//! `dropped` (what records answer and count), `light_sampler`, `quadtree`
+//! and `sd_tree`, `cut` (the learned cut, its sampling rule, records and
+//! refinement), `glt` and `field` (cuts in spatial trees), `schedule`, then
+//! for the integrator `strategy`, `path_recorder`, `mis`, `resampling` and
+//! `shared_guide`.
 //!
 //! ## Where things are
 //!

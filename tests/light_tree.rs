@@ -317,7 +317,7 @@ fn default_heuristic_is_sarh() {
 }
 
 /// Builds are deterministic across processes and runs, not only within
-/// one: the trees of a fixed scene hash (`persist::fingerprint`: every
+/// one: the trees of a fixed scene hash (`light_tree::fingerprint`: every
 /// node's links, emitter, power, bounds and cone) to the values recorded when this test was written. A change
 /// of the builder's result fails here; if it is meant, the new values go
 /// in with the measurement that justified it.
@@ -326,7 +326,7 @@ fn builds_are_deterministic() {
     let scene = mixed_scene(5000, 7);
     let got: Vec<u64> = HEURISTICS
         .iter()
-        .map(|&h| guiding::persist::fingerprint(&build(&scene, h)))
+        .map(|&h| guiding::light_tree::fingerprint(&build(&scene, h)))
         .collect();
     assert_eq!(got, RECORDED_FINGERPRINTS, "{got:#x?}");
 }

@@ -122,8 +122,8 @@ fn light_tree_round_trips() {
         assert_eq!(back.depth(), tree.depth());
         assert_eq!(back.to_bytes(), bytes);
         assert_eq!(
-            guiding::persist::fingerprint(&back),
-            guiding::persist::fingerprint(&tree)
+            guiding::light_tree::fingerprint(&back),
+            guiding::light_tree::fingerprint(&tree)
         );
     }
 }

@@ -9,9 +9,8 @@ use super::cut_rules::CutRules;
 use crate::light_sampler::UnboundedLights;
 use crate::light_tree::LightHierarchy;
 use crate::math::{Counter, SumBuffer};
-use crate::persist::{
-    ACCUMULATION, LoadError, Reader, Writer, config_error, tag, untag,
-};
+use crate::persist::{LoadError, Reader, Writer, tag, untag};
+use crate::math::ACCUMULATION;
 use alloc::vec::Vec;
 
 impl CutConfig {
@@ -68,7 +67,7 @@ impl CutConfig {
             // Version 1 had no learned visibility.
             visibility: r.version() >= 2 && r.bool("cut config: visibility")?,
         };
-        config.validate().map_err(|e| config_error(e, at))?;
+        config.validate().map_err(|e| e.at(at))?;
         Ok(config)
     }
 }

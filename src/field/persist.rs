@@ -4,10 +4,9 @@
 use super::{FieldCell, GuidingField};
 use crate::cut::{CutConfig, CutRules, GuidingCut, OctantSplats};
 use crate::light_tree::LightHierarchy;
-use crate::persist::{
-    FILTERS, Kind, LoadError, Reader, Writer, config_error, fingerprint, read_fingerprint, tag,
-    untag,
-};
+use crate::persist::{Kind, LoadError, Reader, Writer, tag, untag};
+use crate::spatial::FILTERS;
+use crate::light_tree::{fingerprint, read_fingerprint};
 use crate::sd_tree::{SdCell, SdState};
 use crate::spatial::BinaryTree;
 use alloc::vec::Vec;
@@ -41,7 +40,7 @@ impl<H: LightHierarchy> GuidingField<H> {
         let sd = SdState::read(&mut r)?;
         let at = r.offset();
         let config = CutConfig::read(&mut r)?;
-        let guide = CutRules::new(lights, config).map_err(|e| config_error(e, at))?;
+        let guide = CutRules::new(lights, config).map_err(|e| e.at(at))?;
         let light_filter = untag(&mut r, "light filter", &FILTERS)?;
         let cells = BinaryTree::read(&mut r, |r| {
             let sd_cell = SdCell::read(r, &sd.config)?;

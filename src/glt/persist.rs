@@ -8,10 +8,9 @@ use super::guiding_light_tree::Glt;
 use crate::cut::{CutConfig, CutRules, GuidingCut, OctantSplats};
 use crate::dropped::DropCounters;
 use crate::light_tree::LightHierarchy;
-use crate::persist::{
-    FILTERS, Kind, LoadError, Reader, Writer, config_error, fingerprint,
-    read_fingerprint, tag, untag,
-};
+use crate::persist::{Kind, LoadError, Reader, Writer, tag, untag};
+use crate::spatial::FILTERS;
+use crate::light_tree::{fingerprint, read_fingerprint};
 use alloc::vec::Vec;
 
 impl GltConfig {
@@ -35,7 +34,7 @@ impl GltConfig {
             max_bytes: capped.then_some(usize::try_from(bytes).unwrap_or(usize::MAX)),
             light_filter: untag(r, "glt config: filter", &FILTERS)?,
         };
-        config.validate().map_err(|e| config_error(e, at))?;
+        config.validate().map_err(|e| e.at(at))?;
         Ok(config)
     }
 }
@@ -72,7 +71,7 @@ impl<H: LightHierarchy> Glt<H> {
         read_fingerprint(&mut r, &tree)?;
         let at = r.offset();
         let config = GltConfig::read(&mut r)?;
-        let guide = CutRules::new(tree, config.cut).map_err(|e| config_error(e, at))?;
+        let guide = CutRules::new(tree, config.cut).map_err(|e| e.at(at))?;
         let iteration = r.u32("iteration")?;
         let dropped = DropCounters::read(&mut r)?;
         let spatial = crate::spatial::BinaryTree::read(&mut r, |r| {

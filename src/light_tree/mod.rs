@@ -19,3 +19,5 @@ pub use hierarchy::{LightHierarchy, NodeBounds};
 pub use node::LightNode;
 pub use path::EmitterPath;
 pub use tree::LightTree;
+pub use persist::fingerprint;
+pub(crate) use persist::read_fingerprint;

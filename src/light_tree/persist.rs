@@ -1,6 +1,7 @@
 //! Saving and loading a [`LightTree`] (`src/persist/mod.rs` has the
 //! header; `docs/format.md` the layout).
 
+use super::hierarchy::LightHierarchy;
 use super::LightTree;
 use super::node::{LEAF_BIT, LightNode, NO_PARENT};
 use crate::math::Aabb;
@@ -29,7 +30,8 @@ impl LightTree {
     }
 
     pub(crate) fn write(&self, w: &mut Writer) {
-        w.aabb(&self.scene);
+        w.vec3(self.scene.min);
+        w.vec3(self.scene.max);
         w.len(self.nodes.len());
         for n in &self.nodes {
             for x in n.words() {
@@ -44,7 +46,10 @@ impl LightTree {
 
     pub(crate) fn read(r: &mut Reader<'_>) -> Result<Self, LoadError> {
         let at = r.offset();
-        let scene = r.aabb("light tree: scene box")?;
+        let scene = crate::math::Aabb {
+            min: r.vec3("light tree: scene box")?,
+            max: r.vec3("light tree: scene box")?,
+        };
         let count = r.len("light tree: node count", 32)?;
         let mut nodes = Vec::with_capacity(count);
         for _ in 0..count {
@@ -135,4 +140,46 @@ fn check_structure(nodes: &[LightNode], leaf_of: &[u32]) -> Result<usize, &'stat
         return Err("light tree: leaf of emitter");
     }
     Ok(depth)
+}
+
+/// Reads a saved fingerprint and checks it against `tree`'s.
+pub(crate) fn read_fingerprint<H: LightHierarchy + ?Sized>(
+    r: &mut crate::persist::Reader<'_>,
+    tree: &H,
+) -> Result<(), crate::persist::LoadError> {
+    let saved = r.u64("light tree fingerprint")?;
+    let given = fingerprint(tree);
+    if saved == given {
+        Ok(())
+    } else {
+        Err(crate::persist::LoadError::LightTreeMismatch { saved, given })
+    }
+}
+
+/// A fingerprint of a light hierarchy: FNV-1a 64 over every node's
+/// children, emitter, power and decoded bounds, in node order. Equal
+/// hierarchies (the same lights built the same way) have equal
+/// fingerprints; learned state is only loaded against its own.
+pub fn fingerprint<H: LightHierarchy + ?Sized>(tree: &H) -> u64 {
+    let mut h = crate::persist::Fnv::new();
+    let n = tree.node_count();
+    h.u32(n as u32);
+    h.u32(tree.emitter_count() as u32);
+    for i in 0..n as u32 {
+        let [l, r] = tree.children(i).unwrap_or([u32::MAX; 2]);
+        h.u32(l);
+        h.u32(r);
+        h.u32(tree.emitter(i).unwrap_or(u32::MAX));
+        let b = tree.node_bounds(i);
+        h.u32(b.power.to_bits());
+        for v in [b.bounds.min, b.bounds.max, b.cone.axis] {
+            for x in v.to_array() {
+                h.u32(x.to_bits());
+            }
+        }
+        h.u32(b.cone.cos_theta_o.to_bits());
+        h.u32(b.cone.cos_theta_e.to_bits());
+        h.u32(u32::from(b.two_sided));
+    }
+    h.finish()
 }

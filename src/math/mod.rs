@@ -21,4 +21,5 @@ pub(crate) use sphere_map::SPHERE_MAP_JACOBIAN;
 pub(crate) use sphere_map::unit_direction;
 pub use sphere_map::{canonical_to_dir, dir_to_canonical};
 pub use sum::Accumulation;
+pub(crate) use sum::ACCUMULATION;
 pub(crate) use sum::SumBuffer;

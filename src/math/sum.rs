@@ -45,6 +45,10 @@ pub enum Accumulation {
     Deterministic,
 }
 
+/// The save format's byte for each [`Accumulation`] (its position).
+pub(crate) const ACCUMULATION: [Accumulation; 2] =
+    [Accumulation::Fast, Accumulation::Deterministic];
+
 /// A fixed number of non-negative sums that can be added to concurrently.
 #[derive(Debug)]
 pub struct SumBuffer {

@@ -70,12 +70,10 @@ impl Writer {
         self.u64(x.to_bits());
     }
 
-    /// A box: min then max, three `f32` each.
-    pub(crate) fn aabb(&mut self, b: &crate::math::Aabb) {
-        for v in [b.min, b.max] {
-            for x in v.to_array() {
-                self.f32(x);
-            }
+    /// A vector: three `f32`.
+    pub(crate) fn vec3(&mut self, v: glam::Vec3) {
+        for x in v.to_array() {
+            self.f32(x);
         }
     }
 
@@ -264,18 +262,9 @@ impl<'a> Reader<'a> {
         Ok(f64::from_bits(self.u64(field)?))
     }
 
-    /// A box written by [`Writer::aabb`] (not checked).
-    pub(crate) fn aabb(&mut self, field: &'static str) -> Result<crate::math::Aabb, LoadError> {
-        let mut c = [glam::Vec3::ZERO; 2];
-        for v in &mut c {
-            for k in 0..3 {
-                v[k] = self.f32(field)?;
-            }
-        }
-        Ok(crate::math::Aabb {
-            min: c[0],
-            max: c[1],
-        })
+    /// A vector written by [`Writer::vec3`] (not checked).
+    pub(crate) fn vec3(&mut self, field: &'static str) -> Result<glam::Vec3, LoadError> {
+        Ok(glam::Vec3::new(self.f32(field)?, self.f32(field)?, self.f32(field)?))
     }
 
     /// A value that `ok` accepts, else [`LoadError::Invalid`].

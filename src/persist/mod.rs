@@ -43,9 +43,8 @@ pub(crate) use bytes::{Fnv, Reader, Writer};
 pub use error::LoadError;
 #[cfg(feature = "std")]
 pub use io::{read_from, write_to};
-pub(crate) use tags::{ACCUMULATION, FILTERS, config_error, tag, untag};
+pub(crate) use tags::{tag, untag};
 
-use crate::light_tree::LightHierarchy;
 
 /// The format version this build writes (and the newest it reads). It
 /// changes whenever any payload's layout changes; a build reads every
@@ -64,46 +63,4 @@ pub enum Kind {
     Glt = 3,
     /// A [`GuidingField`](crate::field::GuidingField).
     Field = 4,
-}
-
-/// Reads a saved fingerprint and checks it against `tree`'s.
-pub(crate) fn read_fingerprint<H: LightHierarchy + ?Sized>(
-    r: &mut Reader<'_>,
-    tree: &H,
-) -> Result<(), LoadError> {
-    let saved = r.u64("light tree fingerprint")?;
-    let given = fingerprint(tree);
-    if saved == given {
-        Ok(())
-    } else {
-        Err(LoadError::LightTreeMismatch { saved, given })
-    }
-}
-
-/// A fingerprint of a light hierarchy: FNV-1a 64 over every node's
-/// children, emitter, power and decoded bounds, in node order. Equal
-/// hierarchies (the same lights built the same way) have equal
-/// fingerprints; learned state is only loaded against its own.
-pub fn fingerprint<H: LightHierarchy + ?Sized>(tree: &H) -> u64 {
-    let mut h = Fnv::new();
-    let n = tree.node_count();
-    h.u32(n as u32);
-    h.u32(tree.emitter_count() as u32);
-    for i in 0..n as u32 {
-        let [l, r] = tree.children(i).unwrap_or([u32::MAX; 2]);
-        h.u32(l);
-        h.u32(r);
-        h.u32(tree.emitter(i).unwrap_or(u32::MAX));
-        let b = tree.node_bounds(i);
-        h.u32(b.power.to_bits());
-        for v in [b.bounds.min, b.bounds.max, b.cone.axis] {
-            for x in v.to_array() {
-                h.u32(x.to_bits());
-            }
-        }
-        h.u32(b.cone.cos_theta_o.to_bits());
-        h.u32(b.cone.cos_theta_e.to_bits());
-        h.u32(u32::from(b.two_sided));
-    }
-    h.finish()
 }

@@ -1,13 +1,6 @@
-//! Enumerations and configuration errors in the save format.
+//! Enumerations in the save format: a variant as one byte.
 
 use super::{LoadError, Reader};
-use crate::math::Accumulation;
-use crate::spatial::SpatialFilter;
-
-/// A field's `ConfigError` as a load error at `offset`.
-pub(crate) fn config_error(e: crate::ConfigError, offset: usize) -> LoadError {
-    Reader::invalid(e.field, offset)
-}
 
 /// `x` as one byte by its position in `all`.
 pub(crate) fn tag<T: PartialEq + Copy>(all: &[T], x: T) -> u8 {
@@ -26,11 +19,3 @@ pub(crate) fn untag<T: Copy>(
         .copied()
         .ok_or_else(|| Reader::invalid(field, at))
 }
-
-pub(crate) const ACCUMULATION: [Accumulation; 2] =
-    [Accumulation::Fast, Accumulation::Deterministic];
-pub(crate) const FILTERS: [SpatialFilter; 3] = [
-    SpatialFilter::Nearest,
-    SpatialFilter::StochasticBox,
-    SpatialFilter::Box,
-];

@@ -8,9 +8,9 @@ use super::fraction::{FRACTION_SUMS, FractionLearner};
 use super::state::SdState;
 use crate::dropped::DropCounters;
 use crate::math::SumBuffer;
-use crate::persist::{
-    ACCUMULATION, FILTERS, Kind, LoadError, Reader, Writer, config_error, tag, untag,
-};
+use crate::persist::{Kind, LoadError, Reader, Writer, tag, untag};
+use crate::math::ACCUMULATION;
+use crate::spatial::FILTERS;
 use crate::quadtree::{DirectionalFilter, DirectionalTree, QuadtreeConfig};
 use crate::spatial::BinaryTree;
 use alloc::vec::Vec;
@@ -55,7 +55,7 @@ impl SdTreeConfig {
             learn_bsdf_fraction: r.bool("sd config: learn_bsdf_fraction")?,
             fraction_steps: r.u32("sd config: fraction_steps")?,
         };
-        config.validate().map_err(|e| config_error(e, at))?;
+        config.validate().map_err(|e| e.at(at))?;
         Ok(config)
     }
 }

@@ -29,6 +29,13 @@ pub enum SpatialFilter {
     Box,
 }
 
+/// The save format's byte for each [`SpatialFilter`] (its position).
+pub(crate) const FILTERS: [SpatialFilter; 3] = [
+    SpatialFilter::Nearest,
+    SpatialFilter::StochasticBox,
+    SpatialFilter::Box,
+];
+
 impl<T> BinaryTree<T> {
     /// Spreads a record made at `p` over the cells by `filter`: calls
     /// `visit(cell, weight)` for every cell that gets a part, with weights

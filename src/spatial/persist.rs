@@ -18,7 +18,8 @@ impl<T> BinaryTree<T> {
     /// Writes the root cube, the node words and then each cell with
     /// `cell`.
     pub(crate) fn write(&self, w: &mut Writer, mut cell: impl FnMut(&T, &mut Writer)) {
-        w.aabb(&self.root);
+        w.vec3(self.root.min);
+        w.vec3(self.root.max);
         w.len(self.nodes.len());
         for &n in &self.nodes {
             w.u32(n);
@@ -39,7 +40,10 @@ impl<T> BinaryTree<T> {
         mut cell: impl FnMut(&mut Reader<'_>) -> Result<T, LoadError>,
     ) -> Result<Self, LoadError> {
         let at = r.offset();
-        let root = r.aabb("spatial tree: root")?;
+        let root = crate::math::Aabb {
+            min: r.vec3("spatial tree: root")?,
+            max: r.vec3("spatial tree: root")?,
+        };
         if !(root.min.is_finite() && root.max.is_finite() && root.min.cmplt(root.max).all()) {
             return Err(Reader::invalid("spatial tree: root", at));
         }
