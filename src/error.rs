@@ -40,6 +40,7 @@ impl std::error::Error for ConfigError {}
 
 /// Why a guiding structure could not be built.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum Error {
     /// A configuration field is out of range.
     Config(ConfigError),

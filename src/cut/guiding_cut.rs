@@ -68,6 +68,7 @@ pub struct GuidingCut {
 
 /// Why [`GuidingCut::check`] rejected a cut.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum CutError {
     /// A slot points at a cut node that does not exist.
     IndexOutOfRange {

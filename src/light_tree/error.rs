@@ -3,6 +3,7 @@ use core::fmt;
 /// Why a light tree could not be built. Every variant names the offending
 /// emitter so a renderer can report it.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum BuildError {
     /// An emitter's bounds are empty, NaN or infinite.
     InvalidBounds {

@@ -5,6 +5,7 @@
 /// Loading never panics and never trusts a length in the file beyond the
 /// bytes that follow it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum LoadError {
     /// The buffer ends before `field` (at `offset`) is complete.
     Truncated {

@@ -6,6 +6,7 @@ use glam::Vec3;
 
 /// Why a spatial tree could not be built.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum SpatialError {
     /// The scene bounds are empty (`min > max` on some axis).
     EmptyBounds,
