@@ -64,7 +64,7 @@
 //! | the save format and its checks | `src/persist/`, `docs/format.md` |
 //! | light-tree build heuristics | `src/light_tree/build.rs` |
 //! | the importance of a light cluster | `src/light_sampler/importance.rs` |
-//! | the same, from decoded nodes in `f32` (the GLT's importance rules) | `src/light_sampler/importance_table.rs` |
+//! | the same, from decoded nodes in `f32` (the GLT's importance rules) | `src/cut/importance_table.rs` |
 //! | the one-number descent | `src/math/descent.rs` |
 //! | quadtree sampling and pdf | `src/quadtree/query.rs` |
 //!
@@ -159,11 +159,11 @@ layers! {
 pub use glam;
 
 // The lights and the shading point.
-pub use emitter::{Emitter, Emitters, ShadingContext};
+pub use emitter::{Emitter, Emitters};
 pub use light_tree::{BuildError, BuildHeuristic, LightHierarchy, LightTree};
 pub use math::{Aabb, Accumulation};
 // Choosing lights.
-pub use light_sampler::{LightId, LightSample, LightSampler, UnboundedLights};
+pub use light_sampler::{LightId, LightSample, LightSampler, ShadingContext, UnboundedLights};
 pub use strategy::Strategy;
 // The guides, their configurations and their vertices.
 pub use cut::{CutConfig, LightVertex};

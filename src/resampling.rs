@@ -79,7 +79,7 @@
 //! the BSDF sample, with the pmf of the light it hit, as without
 //! resampling.
 
-use crate::emitter::ShadingContext;
+use crate::light_sampler::ShadingContext;
 use crate::light_sampler::{LightId, LightSampler};
 use crate::math::scalar::sqrt64;
 use crate::math::{Descent, Side};

@@ -1,7 +1,8 @@
 //! [`Strategy`]: a light sampler chosen by name, as pbrt's
 //! `lightsamplestrategy`, owning everything it needs.
 
-use crate::emitter::{Emitters, ShadingContext};
+use crate::emitter::Emitters;
+use crate::light_sampler::ShadingContext;
 use crate::error::Error;
 use crate::glt::{Glt, GltConfig};
 use crate::light_sampler::{

@@ -5,7 +5,7 @@ use super::config::CutConfig;
 use super::guiding_cut::GuidingCut;
 use super::walk::WalkTable;
 use crate::error::ConfigError;
-use crate::light_sampler::ImportanceTable;
+use super::importance_table::ImportanceTable;
 use crate::light_tree::LightHierarchy;
 use crate::math::Descent;
 use alloc::vec::Vec;

@@ -25,6 +25,8 @@
 //! - `visibility.rs`: each cluster's learned visibility
 //!   ([`CutRules::splat_visibility`], [`CutConfig::visibility`]), the
 //!   target factor of resampled light choice;
+//! - `importance_table.rs`: the light tree's nodes decoded for the
+//!   importance rules, sibling pairs in the walk's order;
 //! - `octants.rs`: a cell's records counted per octant, which split cells
 //!   share by;
 //! - `config.rs`: [`CutConfig`], [`BelowCut`], [`Modulation`], [`Prior`],
@@ -42,12 +44,13 @@
 //! (through walls). Beyond the paper, by default the learned cut follows
 //! the shading point inside its cell ([`Modulation`], [`Prior`], importance
 //! below the cut: [`CutConfig::with_importance`]), from a decoded
-//! importance table (`src/light_sampler/importance_table.rs`);
+//! importance table (`importance_table.rs`);
 //! [`CutConfig::with_paper_rules`] gives the paper's one distribution per
 //! cell.
 
 mod config;
 mod guiding_cut;
+mod importance_table;
 mod cut_node;
 mod cut_rules;
 mod octants;

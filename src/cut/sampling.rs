@@ -40,8 +40,9 @@ use super::guiding_cut::{GuidingCut, sum_count};
 use super::cut_node::CutNode;
 use super::cut_rules::{CutRules, decode_split};
 use super::walk::WalkNode;
-use crate::emitter::ShadingContext;
-use crate::light_sampler::{FastQuery, ImportanceTable, LightId, LightSample, choose_unbounded};
+use crate::light_sampler::ShadingContext;
+use super::importance_table::{FastQuery, ImportanceTable};
+use crate::light_sampler::{LightId, LightSample, choose_unbounded};
 use crate::light_tree::LightHierarchy;
 use crate::math::{Descent, Side, pmf_to_f32};
 

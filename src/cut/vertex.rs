@@ -6,7 +6,7 @@ use super::guiding_cut::GuidingCut;
 use super::cut_rules::CutRules;
 use super::octants::{OctantSplats, octant_of};
 use crate::dropped::{DropCounters, DropReason};
-use crate::emitter::ShadingContext;
+use crate::light_sampler::ShadingContext;
 use crate::light_sampler::{LightId, LightSample, LightSampler};
 use crate::light_tree::LightHierarchy;
 use crate::math::Aabb;

@@ -3,7 +3,7 @@
 
 use super::{FieldCell, GuidingField};
 use crate::dropped::{DropCounters, DropReason};
-use crate::emitter::ShadingContext;
+use crate::light_sampler::ShadingContext;
 use crate::cut::{LightCells, LightVertex};
 use crate::light_sampler::LightId;
 use crate::light_tree::LightHierarchy;

@@ -8,7 +8,7 @@ use super::memory::GltMemory;
 use crate::cut::CutRules;
 use crate::cut::{LightCells, LightVertex};
 use crate::dropped::{DropCounters, DropReason, DroppedRecords};
-use crate::emitter::ShadingContext;
+use crate::light_sampler::ShadingContext;
 use crate::error::Error;
 use crate::light_sampler::LightId;
 use crate::light_tree::LightHierarchy;

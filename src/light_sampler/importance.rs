@@ -2,7 +2,7 @@
 //! bound as pbrt-v4's `LightBounds::Importance` computes it, with a
 //! scale-invariant distance clamp.
 
-use crate::emitter::ShadingContext;
+use super::ShadingContext;
 use crate::light_tree::NodeBounds;
 use crate::math::scalar::sqrt64;
 use glam::Vec3;

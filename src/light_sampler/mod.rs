@@ -15,8 +15,8 @@
 //! | [`WithUnbounded`] | any of the above plus the scene's unbounded lights (distant, infinite) with a fixed probability |
 //! | [`crate::glt`] | the Guiding Light Tree: learned cuts, then the light tree |
 
+mod context;
 mod importance;
-mod importance_table;
 mod power;
 mod tree_importance;
 mod tree_power;
@@ -24,8 +24,9 @@ mod tree_walk;
 mod unbounded;
 mod uniform;
 
+pub use context::ShadingContext;
 pub use importance::importance;
-pub(crate) use importance_table::{FastQuery, ImportanceTable};
+pub(crate) use importance::BACK_FACTOR;
 pub use power::PowerSampler;
 pub use tree_importance::ImportanceTreeSampler;
 pub use tree_power::PowerTreeSampler;
@@ -33,7 +34,6 @@ pub(crate) use unbounded::choose_unbounded;
 pub use unbounded::{UnboundedLights, WithUnbounded};
 pub use uniform::UniformSampler;
 
-use crate::emitter::ShadingContext;
 
 pub(crate) use crate::math::pmf_to_f32;
 

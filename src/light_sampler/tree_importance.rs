@@ -4,7 +4,7 @@
 
 use super::importance::Query;
 use super::{LightId, LightSample, LightSampler, tree_walk};
-use crate::emitter::ShadingContext;
+use super::ShadingContext;
 use crate::light_tree::LightHierarchy;
 use crate::math::Descent;
 

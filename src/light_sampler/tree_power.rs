@@ -2,7 +2,7 @@
 //! power: the rule the Guiding Light Tree uses below its cuts.
 
 use super::{LightId, LightSample, LightSampler, tree_walk};
-use crate::emitter::ShadingContext;
+use super::ShadingContext;
 use crate::light_tree::LightHierarchy;
 use crate::light_tree::descend::power_weights;
 

@@ -2,7 +2,7 @@
 //! the description of them every sampler shares ([`UnboundedLights`]).
 
 use super::{LightId, LightSample, LightSampler, pmf_to_f32};
-use crate::emitter::ShadingContext;
+use super::ShadingContext;
 use crate::error::{self, ConfigError};
 use crate::math::{Descent, Side};
 

@@ -2,7 +2,7 @@
 //! against.
 
 use super::{LightId, LightSample, LightSampler, pmf_to_f32};
-use crate::emitter::ShadingContext;
+use super::ShadingContext;
 use crate::math::Descent;
 
 /// The most emitters a [`LightId::Emitter`] can name.

@@ -26,7 +26,7 @@
 //! (`max_bytes`), or do not refine them.
 //!
 //! Learned state refers to the light hierarchy it was trained with: the
-//! file holds the hierarchy's [`fingerprint`], and loading against another
+//! file holds the hierarchy's [`fingerprint`](crate::light_tree::fingerprint), and loading against another
 //! hierarchy (other lights, another order, another build) is
 //! [`LoadError::LightTreeMismatch`]. Between runs a renderer may change the
 //! camera, the resolution and the sample counts; it may not change the

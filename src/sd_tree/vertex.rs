@@ -4,7 +4,7 @@
 
 use super::state::SdState;
 use super::{SdCell, SdTree};
-use crate::emitter::ShadingContext;
+use crate::light_sampler::ShadingContext;
 use crate::record::RecordOutcome;
 use crate::spatial::{CellId, Located, SpatialTree};
 use glam::Vec3;

@@ -1,12 +1,12 @@
 //! The light tree's nodes decoded once for fast importance evaluation: the
-//! Estevez-Kulla importance of [`super::importance`] computed in `f32` from
+//! Estevez-Kulla importance of [`crate::light_sampler::importance`] computed in `f32` from
 //! precomputed bounding spheres, without decoding the quantised nodes on
 //! every visit. Entries are 32 bytes and stored as sibling pairs in the
 //! order of the GLT's walk table, so one 64-byte cache line holds both
 //! children a walk step compares.
 
-use super::importance::BACK_FACTOR;
-use crate::emitter::ShadingContext;
+use crate::light_sampler::BACK_FACTOR;
+use crate::light_sampler::ShadingContext;
 use crate::light_tree::{LightHierarchy, NodeBounds};
 use crate::math::scalar::{acos, sqrt};
 use alloc::vec::Vec;
@@ -273,7 +273,7 @@ fn importance(q: &FastQuery, e: &Entry) -> f64 {
 mod tests {
     use super::*;
     use crate::emitter::Emitter;
-    use crate::light_sampler::importance::importance as exact;
+    use crate::light_sampler::importance as exact;
     use crate::light_tree::{BuildHeuristic, LightTree};
 
     /// A one-sided emitter contributes nothing behind its plane, in the
