@@ -209,7 +209,7 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
     }
     assert!(field.cell_count() > 8, "{}", field.cell_count());
     assert!(learned && doubted);
-    // Exact pmfs and samples at random points, by vertex and by position.
+    // Exact pmfs and samples at random points, through the vertex.
     for _ in 0..200 {
         let p = rng.point(11.0);
         let ctx = ShadingContext::at(p);
@@ -219,15 +219,10 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
             let l = LightId::Emitter(e);
             let x = guide.pmf_exact(cut, &ctx, l).to_bits();
             assert_eq!(v.light.pmf_exact(&ctx, l).to_bits(), x);
-            assert_eq!(ByPosition(&field).pmf_exact(&ctx, l).to_bits(), x);
         }
         let u = rng.f64();
         assert_eq!(
             v.light.sample_exact(&ctx, u),
-            guide.sample_exact(cut, &ctx, u)
-        );
-        assert_eq!(
-            ByPosition(&field).sample_exact(&ctx, u),
             guide.sample_exact(cut, &ctx, u)
         );
     }
@@ -359,7 +354,7 @@ proptest! {
 
     /// After random splats and refinements, at random points: every cut is
     /// valid, the pmf sums to 1 (emitters and environment), sampling's pmf
-    /// equals `pmf` bit for bit (by vertex and by position, `f32` and
+    /// equals `pmf` bit for bit (through the vertex, `f32` and
     /// `f64`), and sampled directions' pdfs equal `direction_pdf`.
     #[test]
     fn contract_at_random_points(
@@ -416,7 +411,6 @@ proptest! {
             for _ in 0..20 {
                 let u = rng.f();
                 let s = v.light.sample(&ctx, u).unwrap();
-                prop_assert_eq!(Some(s), ByPosition(&field).sample(&ctx, u));
                 prop_assert_eq!(s.pmf.to_bits(), v.light.pmf(&ctx, s.light).to_bits());
                 prop_assert_eq!(s.pmf.to_bits(), ByPosition(&field).pmf(&ctx, s.light).to_bits());
                 let (l, q) = v.light.sample_exact(&ctx, rng.f64()).unwrap();

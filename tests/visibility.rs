@@ -79,14 +79,12 @@ fn room_visibility(glt: &impl LightSampler, p: Vec3) -> (f32, f32) {
 fn each_room_learns_the_other_is_hidden() {
     let glt = trained(true);
     for p in [Vec3::new(-5.0, 1.0, 2.0), Vec3::new(6.0, -3.0, -1.0)] {
-        let (own, other) = room_visibility(&ByPosition(&glt), p);
+        let v = glt.vertex(&ShadingContext::at(p)).unwrap();
+        let (own, other) = room_visibility(&v, p);
         assert!(
             own > 0.8 && other < 0.2,
             "at {p}: own room {own}, other {other}"
         );
-        // The vertex answers as the GLT by position.
-        let v = glt.vertex(&ShadingContext::at(p)).unwrap();
-        assert_eq!(room_visibility(&v, p), (own, other));
     }
 }
 
@@ -254,24 +252,21 @@ fn sampling_with_visibility_equals_sampling_then_visibility() {
             let p = rng.point(9.5);
             let ctx = ShadingContext::on_surface(p, Vec3::Y);
             let u = rng.f();
-            let vertex = glt.vertex(&ShadingContext::at(p)).unwrap();
-            let samplers: [&dyn LightSampler; 2] = [&ByPosition(&glt), &vertex];
-            for s in samplers {
-                let want = s.sample(&ctx, u).map(|x| (x, s.visibility(&ctx, x.light)));
-                let got = s.sample_with_visibility(&ctx, u);
-                assert_eq!(
-                    got.map(|(x, v)| (x, v.to_bits())),
-                    want.map(|(x, v)| (x, v.to_bits())),
-                    "at {p} with u = {u}"
-                );
-                draws += usize::from(got.is_some());
-                learned += usize::from(got.is_some_and(|(_, v)| v < 0.99));
-            }
+            let s = glt.vertex(&ctx).unwrap();
+            let want = s.sample(&ctx, u).map(|x| (x, s.visibility(&ctx, x.light)));
+            let got = s.sample_with_visibility(&ctx, u);
+            assert_eq!(
+                got.map(|(x, v)| (x, v.to_bits())),
+                want.map(|(x, v)| (x, v.to_bits())),
+                "at {p} with u = {u}"
+            );
+            draws += usize::from(got.is_some());
+            learned += usize::from(got.is_some_and(|(_, v)| v < 0.99));
         }
         // The check has something to see: most draws answer, and many of
         // them with a visibility learned below 1.
         assert!(
-            draws > 5000 && learned > 100,
+            draws > 2500 && learned > 50,
             "{draws} draws, {learned} learned"
         );
     }

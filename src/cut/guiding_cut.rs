@@ -139,6 +139,15 @@ impl core::ops::AddAssign for CutMemory {
     }
 }
 
+impl core::iter::Sum for CutMemory {
+    fn sum<I: Iterator<Item = Self>>(iter: I) -> Self {
+        iter.fold(Self::default(), |mut a, b| {
+            a += b;
+            a
+        })
+    }
+}
+
 impl GuidingCut {
     /// The initial cut (see [`CutRules::new_cut`](super::CutRules::new_cut)).
     pub(crate) fn new<H: LightHierarchy + ?Sized>(tree: &H, config: &CutConfig) -> Self {

@@ -33,12 +33,3 @@ impl GltMemory {
         (self.total() - self.shared_bytes) as f64 / self.cells.max(1) as f64
     }
 }
-
-impl core::iter::Sum for CutMemory {
-    fn sum<I: Iterator<Item = Self>>(iter: I) -> Self {
-        iter.fold(Self::default(), |mut a, b| {
-            a += b;
-            a
-        })
-    }
-}
