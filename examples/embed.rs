@@ -17,7 +17,7 @@
 use guiding::glam::Vec3;
 use guiding::{
     Aabb, BuildHeuristic, Convention, Emitter, Glt, GltConfig, LightId, LightSampler, LightTree,
-    ShadingContext, Strategy, UnboundedLights,
+    LightVertex, ShadingContext, Strategy, UnboundedLights,
 };
 use rand_pcg::Pcg32;
 use rand_pcg::rand_core::{Rng, SeedableRng};
@@ -84,30 +84,47 @@ enum Nee<'a> {
     },
 }
 
+impl<'a> Nee<'a> {
+    /// Runs `f` with the light choice at `ctx`: the GLT's vertex there
+    /// (one lookup; also what to record into when learning) or the fixed
+    /// sampler.
+    fn at<R>(
+        self,
+        ctx: &ShadingContext,
+        f: impl FnOnce(&dyn LightSampler, Option<&LightVertex<'a, &'a LightTree>>) -> R,
+    ) -> R {
+        match self {
+            Nee::Fixed(s) => f(s, None),
+            Nee::Guided { glt, learn } => {
+                let v = glt.vertex(ctx).expect("the floor's points are finite");
+                f(&v, learn.then_some(&v))
+            }
+        }
+    }
+}
+
 /// One irradiance estimate at `p` (normal +y): one NEE sample and one
 /// cosine-sampled direction, MIS-combined. With `Nee::Guided { learn:
 /// true, .. }`, both are recorded into the GLT.
 fn estimate(lights: &[Sphere], nee: Nee, p: Vec3, rng: &mut Pcg32) -> f32 {
-    let n = Vec3::Y;
-    let ctx = ShadingContext::on_surface(p, n);
-    // The GLT: locate the point's cell once; it samples and records.
-    let vertex = match nee {
-        Nee::Guided { glt, .. } => glt.vertex(&ctx),
-        Nee::Fixed(_) => None,
-    };
-    let sampler: &dyn LightSampler = match (&vertex, nee) {
-        (Some(v), _) => v,
-        (None, Nee::Fixed(s)) => s,
-        (None, Nee::Guided { .. }) => unreachable!("the floor's points are finite"),
-    };
-    let learn = match nee {
-        Nee::Guided { learn, .. } => learn,
-        Nee::Fixed(_) => false,
-    };
-    let record = vertex.filter(|_| learn);
+    let ctx = ShadingContext::on_surface(p, Vec3::Y);
+    nee.at(&ctx, |sampler, record| {
+        estimate_with(lights, sampler, record, &ctx, rng)
+    })
+}
+
+/// [`estimate`] with the light choice located.
+fn estimate_with(
+    lights: &[Sphere],
+    sampler: &dyn LightSampler,
+    record: Option<&LightVertex<&LightTree>>,
+    ctx: &ShadingContext,
+    rng: &mut Pcg32,
+) -> f32 {
+    let (p, n) = (ctx.position, Vec3::Y);
     let mut e = 0.0;
     // NEE: choose a light, then a direction towards it.
-    if let Some(s) = sampler.sample(&ctx, uniform(rng)) {
+    if let Some(s) = sampler.sample(ctx, uniform(rng)) {
         let LightId::Emitter(i) = s.light else {
             unreachable!("no unbounded lights here")
         };
@@ -136,7 +153,7 @@ fn estimate(lights: &[Sphere], nee: Nee, p: Vec3, rng: &mut Pcg32) -> f32 {
         if visible(p, light.center) {
             let (_, pdf_dir) = sample_sphere(light, p, [0.0, 0.0]);
             let id = LightId::Emitter(i as u32);
-            let d = Convention::PbrtV4.bsdf_sample(sampler.pmf(&ctx, id), pdf_dir, pdf_bsdf);
+            let d = Convention::PbrtV4.bsdf_sample(sampler.pmf(ctx, id), pdf_dir, pdf_bsdf);
             e += light.radiance * dir.y * d.factor;
             if let Some(v) = &record {
                 v.record_light(id, light.radiance * d.factor);
@@ -213,19 +230,12 @@ pub fn run() -> bool {
         .collect();
     let left = ShadingContext::on_surface(Vec3::new(-2.0, 0.0, 0.0), Vec3::Y);
     let hidden = |nee: Nee| -> f32 {
-        let located = match nee {
-            Nee::Guided { glt, .. } => glt.vertex(&left),
-            Nee::Fixed(_) => None,
-        };
-        let s: &dyn LightSampler = match (&located, nee) {
-            (Some(v), _) => v,
-            (None, Nee::Fixed(s)) => s,
-            (None, Nee::Guided { .. }) => unreachable!("a finite point"),
-        };
-        (1..32)
-            .step_by(2)
-            .map(|i| s.pmf(&left, LightId::Emitter(i)))
-            .sum()
+        nee.at(&left, |s, _| {
+            (1..32)
+                .step_by(2)
+                .map(|i| s.pmf(&left, LightId::Emitter(i)))
+                .sum()
+        })
     };
     let uniform_sampler =
         Strategy::new("uniform", &emitters[..], UnboundedLights::NONE, bounds).expect("lights");
