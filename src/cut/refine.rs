@@ -216,7 +216,12 @@ fn anchor_importances(
     (table, anchor): (&ImportanceTable, FastQuery),
     pair: u32,
 ) -> Option<(f64, f64)> {
-    let (l, r) = table.pair_importance(&anchor, pair);
+    floored(table.pair_importance(&anchor, pair))
+}
+
+/// Two importances, each at least 1e-6 of their sum; `None` when the sum
+/// is zero or not finite.
+fn floored((l, r): (f64, f64)) -> Option<(f64, f64)> {
     let t = l + r;
     (t > 0.0 && t.is_finite()).then(|| (l.max(1e-6 * t), r.max(1e-6 * t)))
 }
@@ -436,6 +441,132 @@ mod tests {
                 };
                 assert_eq!(capped.nodes, expected, "cap {cap}, sigma {sigma0}");
             }
+        }
+    }
+
+    /// Two emitters, the first of power `left`, the second `right`, and
+    /// the root's children in emitter order (the left child is the
+    /// first emitter).
+    fn pair(left: f32, right: f32) -> (LightTree, [u32; 2]) {
+        let lights = [
+            Emitter::point(Vec3::ZERO, left),
+            Emitter::point(Vec3::X, right),
+        ];
+        let tree = LightTree::build(&lights[..], BuildHeuristic::Sarh).unwrap();
+        let mut children = tree.children(tree.root().unwrap()).unwrap();
+        if tree.power(children[0]) != left {
+            children.swap(0, 1);
+        }
+        (tree, children)
+    }
+
+    /// A fresh split shares its weight by the prior: evenly between lit
+    /// children (all of it to the one lit child), or by power; a pair
+    /// with no power takes nothing, never NaN.
+    #[test]
+    fn a_fresh_split_shares_its_weight_by_the_prior() {
+        use SplitPrior::{Half, Power};
+        let weights = |l: f32, r: f32, prior| {
+            let (tree, children) = pair(l, r);
+            split_weight(&tree, children, 8.0, prior)
+        };
+        assert_eq!(weights(1.0, 3.0, Half), (4.0, 4.0));
+        assert_eq!(weights(1.0, 3.0, Power), (2.0, 6.0));
+        assert_eq!(weights(1.0, 0.0, Half), (8.0, 0.0));
+        assert_eq!(weights(0.0, 3.0, Half), (0.0, 8.0));
+        assert_eq!(weights(0.0, 3.0, Power), (0.0, 8.0));
+        assert_eq!(weights(0.0, 0.0, Half), (0.0, 0.0));
+        assert_eq!(weights(0.0, 0.0, Power), (0.0, 0.0));
+    }
+
+    /// With an anchor a fresh split follows the importances there, a dark
+    /// child (no power) getting nothing whatever its importance; no split
+    /// weight when neither side can take it. The importances are floored
+    /// at 1e-6 of their sum.
+    #[test]
+    fn a_fresh_split_follows_the_importance_at_the_anchor() {
+        let (tree, children) = pair(1.0, 1.0);
+        assert_eq!(split_by_importance(&tree, children, 8.0, (1.0, 3.0)), Some((2.0, 6.0)));
+        assert_eq!(split_by_importance(&tree, children, 8.0, (0.0, 0.0)), None);
+        assert_eq!(split_by_importance(&tree, children, 8.0, (f64::INFINITY, 1.0)), None);
+        let (tree, children) = pair(0.0, 1.0);
+        assert_eq!(split_by_importance(&tree, children, 8.0, (5.0, 3.0)), Some((0.0, 8.0)));
+        assert_eq!(split_by_importance(&tree, children, 8.0, (5.0, 0.0)), None);
+
+        assert_eq!(floored((3.0, 1.0)), Some((3.0, 1.0)));
+        assert_eq!(floored((0.0, 2.0)), Some((2e-6, 2.0)));
+        assert_eq!(floored((4.0, 0.0)), Some((4.0, 4e-6)));
+        assert_eq!(floored((0.0, 0.0)), None);
+        assert_eq!(floored((f64::INFINITY, 1.0)), None);
+        assert_eq!(floored((f64::NAN, 1.0)), None);
+    }
+
+    /// The stored `p_left` is the weights' ratio, or with importances the
+    /// ratio of the learned factors `weight / importance`; where those
+    /// overflow, the weights' ratio.
+    #[test]
+    fn p_left_is_the_ratio_of_the_learned_factors() {
+        assert_eq!(stored_p_left((1.0, 3.0), None), 0.25);
+        assert_eq!(stored_p_left((1.0, 3.0), Some((1.0, 3.0))), 0.5);
+        assert_eq!(stored_p_left((1.0, 3.0), Some((1.0, 1.0))), 0.25);
+        assert_eq!(stored_p_left((3.0, 1.0), Some((1.0, 9.0))), 27.0 / 28.0);
+        assert_eq!(stored_p_left((1e300, 3e300), Some((1e-300, 1.0))), 0.25);
+    }
+
+    /// [`CutRules::growth`] with nothing learned from emitters (only an
+    /// unbounded light recorded): the refinement keeps the cut, and the
+    /// prediction keeps its node count.
+    #[test]
+    fn growth_keeps_the_cut_when_only_unbounded_lights_were_recorded() {
+        let lights: Vec<Emitter> = (0..16)
+            .map(|i| Emitter::point(Vec3::new(i as f32, 0.0, 0.0), 1.0 + i as f32))
+            .collect();
+        let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+        let config = CutConfig {
+            unbounded: UnboundedLights::new(1, 0.1).unwrap(),
+            ..CutConfig::default()
+        };
+        let guide = CutRules::new(&tree, config).unwrap();
+        let mut cut = guide.new_cut();
+        for k in 0..4000u32 {
+            guide.splat(&cut, LightId::Emitter(k % 16), 1.0 + (k % 16) as f32);
+        }
+        assert!(guide.refine(&mut cut));
+        let nodes = cut.nodes.len();
+        assert!(nodes > 2, "{nodes}");
+        for _ in 0..4000 {
+            guide.splat(&cut, LightId::Unbounded(0), 1.0);
+        }
+        let g = guide.growth(&cut);
+        assert!(!guide.refine(&mut cut));
+        assert_eq!((g.nodes, cut.nodes.len()), (nodes, nodes));
+    }
+
+    /// Records on lights without power (a renderer's power estimate can
+    /// be 0 where its emission is not): the cluster they fill is not
+    /// split (neither child can take a weight), so no cut node gets a
+    /// `p_left` of `0 / 0`.
+    #[test]
+    fn records_on_dark_lights_split_nothing_dark() {
+        let lights = [
+            Emitter::point(Vec3::ZERO, 1.0),
+            Emitter::point(Vec3::X, 2.0),
+            Emitter::point(Vec3::new(100.0, 0.0, 0.0), 0.0),
+            Emitter::point(Vec3::new(101.0, 0.0, 0.0), 0.0),
+        ];
+        let tree = LightTree::build(&lights[..], BuildHeuristic::Sarh).unwrap();
+        let config = CutConfig {
+            sigma: 0.0,
+            ..CutConfig::default()
+        };
+        let guide = CutRules::new(&tree, config).unwrap();
+        let mut cut = guide.new_cut();
+        for k in 0..4000u32 {
+            guide.splat(&cut, LightId::Emitter(k % 4), 1.0);
+        }
+        guide.refine(&mut cut);
+        for node in &cut.nodes {
+            assert!((0.0..=1.0).contains(&node.p_left()), "{node:?}");
         }
     }
 }

@@ -265,6 +265,8 @@ mod tests {
     #[test]
     fn ending_a_pass_sets_the_confidence_and_restarts_the_count() {
         let mut c = cell_with([10, 390, 0, 0, 0, 0, 0, 0], 0);
+        assert_eq!(c.octant_splats(), [10, 390, 0, 0, 0, 0, 0, 0]);
+        assert_eq!(c.generation(), 0);
         c.begin();
         let mut upper = c.split(0);
         upper.end(true);
@@ -272,7 +274,9 @@ mod tests {
         c.end(false);
         assert_eq!(c.cut.confidence(), 0.5);
         assert_eq!((c.splats(), c.used, c.generation), (0, 10, 1));
+        assert_eq!((c.octant_splats(), c.generation()), ([0; 8], 1));
         c.octants.count(3);
+        assert_eq!(c.octant_splats(), [0, 0, 0, 1, 0, 0, 0, 0]);
         c.begin();
         assert!(!c.pass.ready, "1 of the 15 it needs");
         for _ in 1..15 {
