@@ -112,25 +112,67 @@
 
 extern crate alloc;
 
-/// Declares the crate's modules: private by default, so the crate root's
-/// re-exports below are the whole front a renderer sees; public with the
-/// `inspect` feature, which the tests, benchmarks and research examples
-/// enable to reach the second tier (a cut's nodes, the spatial tree's
-/// cells, the quadtrees, the save format's pieces).
-macro_rules! layers {
+// The crate's modules: private by default, so the crate root's re-exports
+// below are the whole front a renderer sees; public with the `inspect`
+// feature, which the tests, benchmarks and research examples enable to reach
+// the second tier (a cut's nodes, the spatial tree's cells, the quadtrees,
+// the save format's pieces). The private declarations are written out (not
+// made by the macro) so that tools that find a crate's files by reading its
+// `mod` items, such as cargo-mutants, see every module once.
+#[cfg(not(feature = "inspect"))]
+mod cut;
+#[cfg(not(feature = "inspect"))]
+mod dropped;
+#[cfg(not(feature = "inspect"))]
+mod emitter;
+#[cfg(not(feature = "inspect"))]
+mod error;
+#[cfg(not(feature = "inspect"))]
+mod field;
+#[cfg(not(feature = "inspect"))]
+mod glt;
+#[cfg(not(feature = "inspect"))]
+mod light_sampler;
+#[cfg(not(feature = "inspect"))]
+mod light_tree;
+#[cfg(not(feature = "inspect"))]
+mod math;
+#[cfg(not(feature = "inspect"))]
+mod mis;
+#[cfg(not(feature = "inspect"))]
+mod path_recorder;
+#[cfg(not(feature = "inspect"))]
+mod persist;
+#[cfg(not(feature = "inspect"))]
+mod quadtree;
+#[cfg(not(feature = "inspect"))]
+mod record;
+#[cfg(not(feature = "inspect"))]
+mod resampling;
+#[cfg(not(feature = "inspect"))]
+mod schedule;
+#[cfg(not(feature = "inspect"))]
+mod sd_tree;
+#[cfg(feature = "std")]
+#[cfg(not(feature = "inspect"))]
+mod shared_guide;
+#[cfg(not(feature = "inspect"))]
+mod spatial;
+#[cfg(not(feature = "inspect"))]
+mod strategy;
+
+/// The same modules, public: the `inspect` tier.
+macro_rules! inspect_tier {
     ($($(#[$attr:meta])* $name:ident;)*) => {
         $(
             $(#[$attr])*
             #[cfg(feature = "inspect")]
             pub mod $name;
-            $(#[$attr])*
-            #[cfg(not(feature = "inspect"))]
-            mod $name;
         )*
     };
 }
 
-layers! {
+inspect_tier! {
     cut;
     dropped;
     emitter;
