@@ -2,9 +2,9 @@
 //! `lightsamplestrategy`, owning everything it needs.
 
 use crate::emitter::Emitters;
-use crate::light_sampler::ShadingContext;
 use crate::error::Error;
 use crate::glt::{Glt, GltConfig};
+use crate::light_sampler::ShadingContext;
 use crate::light_sampler::{
     ImportanceTreeSampler, LightId, LightSample, LightSampler, PowerSampler, UnboundedLights,
     UniformSampler, WithUnbounded,

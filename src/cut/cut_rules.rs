@@ -3,9 +3,9 @@
 
 use super::config::CutConfig;
 use super::guiding_cut::GuidingCut;
+use super::importance_table::ImportanceTable;
 use super::walk::WalkTable;
 use crate::error::ConfigError;
-use super::importance_table::ImportanceTable;
 use crate::light_tree::LightHierarchy;
 use crate::math::Descent;
 use alloc::vec::Vec;

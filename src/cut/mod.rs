@@ -49,10 +49,10 @@
 //! cell.
 
 mod config;
-mod guiding_cut;
-mod importance_table;
 mod cut_node;
 mod cut_rules;
+mod guiding_cut;
+mod importance_table;
 mod octants;
 mod persist;
 mod refine;
@@ -63,9 +63,9 @@ mod visibility;
 mod walk;
 
 pub use config::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
-pub use guiding_cut::{CutError, CutMemory, GuidingCut};
 pub use cut_node::{CutNode, Slot};
 pub use cut_rules::CutRules;
+pub use guiding_cut::{CutError, CutMemory, GuidingCut};
 pub(crate) use octants::OctantSplats;
-pub use vertex::LightVertex;
 pub(crate) use vertex::LightCells;
+pub use vertex::LightVertex;

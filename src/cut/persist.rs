@@ -3,14 +3,14 @@
 //! the GLT and the field save their cells' cuts through these.
 
 use super::config::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
-use super::guiding_cut::{GuidingCut, MIN_VISIBILITY, anchor_sums, sum_count, visibility_slots};
 use super::cut_node::CutNode;
 use super::cut_rules::CutRules;
+use super::guiding_cut::{GuidingCut, MIN_VISIBILITY, anchor_sums, sum_count, visibility_slots};
 use crate::light_sampler::UnboundedLights;
 use crate::light_tree::LightHierarchy;
+use crate::math::ACCUMULATION;
 use crate::math::{Counter, SumBuffer};
 use crate::persist::{LoadError, Reader, Writer, tag, untag};
-use crate::math::ACCUMULATION;
 use alloc::vec::Vec;
 
 impl CutConfig {
@@ -205,4 +205,3 @@ impl GuidingCut {
         true
     }
 }
-

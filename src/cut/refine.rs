@@ -2,12 +2,12 @@
 //! above `sigma`, end (merge) where it is not.
 
 use super::config::{Modulation, SplitPrior};
-use super::guiding_cut::{GuidingCut, sum_count};
 use super::cut_node::{CutNode, Slot};
 use super::cut_rules::CutRules;
+use super::guiding_cut::{GuidingCut, sum_count};
+use super::importance_table::{FastQuery, ImportanceTable};
 use super::walk::WalkNode;
 use crate::light_sampler::ShadingContext;
-use super::importance_table::{FastQuery, ImportanceTable};
 use crate::light_tree::LightHierarchy;
 use crate::math::Side;
 use crate::spatial::Growth;
@@ -342,8 +342,8 @@ fn rebuild<H: LightHierarchy>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::emitter::Emitter;
     use crate::cut::CutConfig;
+    use crate::emitter::Emitter;
     use crate::light_sampler::{LightId, UnboundedLights};
     use crate::light_tree::{BuildHeuristic, LightTree};
     use glam::Vec3;
@@ -486,11 +486,20 @@ mod tests {
     #[test]
     fn a_fresh_split_follows_the_importance_at_the_anchor() {
         let (tree, children) = pair(1.0, 1.0);
-        assert_eq!(split_by_importance(&tree, children, 8.0, (1.0, 3.0)), Some((2.0, 6.0)));
+        assert_eq!(
+            split_by_importance(&tree, children, 8.0, (1.0, 3.0)),
+            Some((2.0, 6.0))
+        );
         assert_eq!(split_by_importance(&tree, children, 8.0, (0.0, 0.0)), None);
-        assert_eq!(split_by_importance(&tree, children, 8.0, (f64::INFINITY, 1.0)), None);
+        assert_eq!(
+            split_by_importance(&tree, children, 8.0, (f64::INFINITY, 1.0)),
+            None
+        );
         let (tree, children) = pair(0.0, 1.0);
-        assert_eq!(split_by_importance(&tree, children, 8.0, (5.0, 3.0)), Some((0.0, 8.0)));
+        assert_eq!(
+            split_by_importance(&tree, children, 8.0, (5.0, 3.0)),
+            Some((0.0, 8.0))
+        );
         assert_eq!(split_by_importance(&tree, children, 8.0, (5.0, 0.0)), None);
 
         assert_eq!(floored((3.0, 1.0)), Some((3.0, 1.0)));

@@ -36,12 +36,12 @@
 //! equals [`CutRules::pmf_exact`] bit for bit, fallbacks included.
 
 use super::config::{BelowCut, CutConfig, Modulation, Prior};
-use super::guiding_cut::{GuidingCut, sum_count};
 use super::cut_node::CutNode;
 use super::cut_rules::{CutRules, decode_split};
+use super::guiding_cut::{GuidingCut, sum_count};
+use super::importance_table::{FastQuery, ImportanceTable};
 use super::walk::WalkNode;
 use crate::light_sampler::ShadingContext;
-use super::importance_table::{FastQuery, ImportanceTable};
 use crate::light_sampler::{LightId, LightSample, choose_unbounded};
 use crate::light_tree::LightHierarchy;
 use crate::math::{Descent, Side, pmf_to_f32};

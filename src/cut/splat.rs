@@ -1,8 +1,8 @@
 //! Recording direct-light estimates into a cut's accumulating copy.
 
 use super::config::Modulation;
-use super::guiding_cut::GuidingCut;
 use super::cut_rules::CutRules;
+use super::guiding_cut::GuidingCut;
 use crate::light_sampler::LightId;
 use crate::light_tree::LightHierarchy;
 use crate::record::RecordOutcome;

@@ -2,8 +2,8 @@
 //! cut-based [`LightSampler`], serving every light query and record at a
 //! path vertex for the GLT and the guiding field alike.
 
-use super::guiding_cut::GuidingCut;
 use super::cut_rules::CutRules;
+use super::guiding_cut::GuidingCut;
 use super::octants::{OctantSplats, octant_of};
 use crate::dropped::{DropCounters, DropReason};
 use crate::light_sampler::ShadingContext;

@@ -25,9 +25,9 @@
 //! [`CutConfig::visibility`]: super::CutConfig::visibility
 //! [`CutConfig::min_splats`]: super::CutConfig::min_splats
 
-use super::guiding_cut::{GuidingCut, MIN_VISIBILITY, visibility_slots};
 use super::cut_node::{CutNode, Slot};
 use super::cut_rules::CutRules;
+use super::guiding_cut::{GuidingCut, MIN_VISIBILITY, visibility_slots};
 use crate::light_sampler::LightId;
 use crate::light_tree::LightHierarchy;
 use crate::record::RecordOutcome;
@@ -237,8 +237,8 @@ fn below(old: &[CutNode], estimates: &[(f64, f64)], i: usize) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::emitter::Emitter;
     use crate::cut::CutConfig;
+    use crate::emitter::Emitter;
     use crate::light_sampler::UnboundedLights;
     use crate::light_tree::{BuildHeuristic, LightTree};
     use glam::Vec3;

@@ -113,9 +113,9 @@ pub use config::FieldConfig;
 pub use memory::FieldMemory;
 pub use vertex::FieldVertex;
 
+use crate::cut::CutRules;
 use crate::dropped::DroppedRecords;
 use crate::error::Error;
-use crate::cut::CutRules;
 use crate::light_tree::LightHierarchy;
 use crate::math::Aabb;
 use crate::sd_tree::SdState;

@@ -4,11 +4,11 @@
 use super::{FieldCell, GuidingField};
 use crate::cut::{CutConfig, CutRules, GuidingCut, OctantSplats};
 use crate::light_tree::LightHierarchy;
-use crate::persist::{Kind, LoadError, Reader, Writer, tag, untag};
-use crate::spatial::FILTERS;
 use crate::light_tree::{fingerprint, read_fingerprint};
+use crate::persist::{Kind, LoadError, Reader, Writer, tag, untag};
 use crate::sd_tree::{SdCell, SdState};
 use crate::spatial::BinaryTree;
+use crate::spatial::FILTERS;
 use alloc::vec::Vec;
 
 impl<H: LightHierarchy> GuidingField<H> {

@@ -2,10 +2,10 @@
 //! guiding and its light choice.
 
 use super::{FieldCell, GuidingField};
-use crate::dropped::{DropCounters, DropReason};
-use crate::light_sampler::ShadingContext;
 use crate::cut::{LightCells, LightVertex};
+use crate::dropped::{DropCounters, DropReason};
 use crate::light_sampler::LightId;
+use crate::light_sampler::ShadingContext;
 use crate::light_tree::LightHierarchy;
 use crate::record::RecordOutcome;
 use crate::sd_tree::{DirectionVertex, RadianceCells};

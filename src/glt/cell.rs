@@ -186,8 +186,8 @@ impl GltCell {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::emitter::Emitter;
     use crate::cut::{CutConfig, CutRules};
+    use crate::emitter::Emitter;
     use crate::light_tree::{BuildHeuristic, LightTree};
     use glam::Vec3;
 

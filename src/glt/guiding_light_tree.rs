@@ -8,9 +8,9 @@ use super::memory::GltMemory;
 use crate::cut::CutRules;
 use crate::cut::{LightCells, LightVertex};
 use crate::dropped::{DropCounters, DropReason, DroppedRecords};
-use crate::light_sampler::ShadingContext;
 use crate::error::Error;
 use crate::light_sampler::LightId;
+use crate::light_sampler::ShadingContext;
 use crate::light_tree::LightHierarchy;
 use crate::math::Aabb;
 use crate::record::RecordOutcome;
@@ -211,4 +211,3 @@ impl<H: LightHierarchy> LightCells for Glt<H> {
         &self.dropped
     }
 }
-

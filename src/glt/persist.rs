@@ -8,9 +8,9 @@ use super::guiding_light_tree::Glt;
 use crate::cut::{CutConfig, CutRules, GuidingCut, OctantSplats};
 use crate::dropped::DropCounters;
 use crate::light_tree::LightHierarchy;
+use crate::light_tree::{fingerprint, read_fingerprint};
 use crate::persist::{Kind, LoadError, Reader, Writer, tag, untag};
 use crate::spatial::FILTERS;
-use crate::light_tree::{fingerprint, read_fingerprint};
 use alloc::vec::Vec;
 
 impl GltConfig {

@@ -25,15 +25,14 @@ mod unbounded;
 mod uniform;
 
 pub use context::ShadingContext;
-pub use importance::importance;
 pub(crate) use importance::BACK_FACTOR;
+pub use importance::importance;
 pub use power::PowerSampler;
 pub use tree_importance::ImportanceTreeSampler;
 pub use tree_power::PowerTreeSampler;
 pub(crate) use unbounded::choose_unbounded;
 pub use unbounded::{UnboundedLights, WithUnbounded};
 pub use uniform::UniformSampler;
-
 
 pub(crate) use crate::math::pmf_to_f32;
 

@@ -1,8 +1,8 @@
 //! Light selection proportional to power, with Walker's alias method.
 
+use super::ShadingContext;
 use super::{LightId, LightSample, LightSampler, pmf_to_f32};
 use crate::emitter::Emitters;
-use super::ShadingContext;
 use crate::math::Descent;
 use alloc::vec::Vec;
 

@@ -2,9 +2,9 @@
 //! cluster's importance at the shading point (Estevez & Kulla 2018, pbrt-v4's
 //! `BVHLightSampler`).
 
+use super::ShadingContext;
 use super::importance::Query;
 use super::{LightId, LightSample, LightSampler, tree_walk};
-use super::ShadingContext;
 use crate::light_tree::LightHierarchy;
 use crate::math::Descent;
 

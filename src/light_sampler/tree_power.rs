@@ -1,8 +1,8 @@
 //! Light selection by descending a light hierarchy in proportion to subtree
 //! power: the rule the Guiding Light Tree uses below its cuts.
 
-use super::{LightId, LightSample, LightSampler, tree_walk};
 use super::ShadingContext;
+use super::{LightId, LightSample, LightSampler, tree_walk};
 use crate::light_tree::LightHierarchy;
 use crate::light_tree::descend::power_weights;
 

@@ -1,8 +1,8 @@
 //! Unbounded lights (distant and infinite) beside any emitter sampler, and
 //! the description of them every sampler shares ([`UnboundedLights`]).
 
-use super::{LightId, LightSample, LightSampler, pmf_to_f32};
 use super::ShadingContext;
+use super::{LightId, LightSample, LightSampler, pmf_to_f32};
 use crate::error::{self, ConfigError};
 use crate::math::{Descent, Side};
 

@@ -1,8 +1,8 @@
 //! Uniform light selection: the baseline every other sampler is measured
 //! against.
 
-use super::{LightId, LightSample, LightSampler, pmf_to_f32};
 use super::ShadingContext;
+use super::{LightId, LightSample, LightSampler, pmf_to_f32};
 use crate::math::Descent;
 
 /// The most emitters a [`LightId::Emitter`] can name.

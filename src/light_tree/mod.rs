@@ -18,6 +18,6 @@ pub use error::BuildError;
 pub use hierarchy::{LightHierarchy, NodeBounds};
 pub use node::LightNode;
 pub use path::EmitterPath;
-pub use tree::LightTree;
 pub use persist::fingerprint;
 pub(crate) use persist::read_fingerprint;
+pub use tree::LightTree;

@@ -1,8 +1,8 @@
 //! Saving and loading a [`LightTree`] (`src/persist/mod.rs` has the
 //! header; `docs/format.md` the layout).
 
-use super::hierarchy::LightHierarchy;
 use super::LightTree;
+use super::hierarchy::LightHierarchy;
 use super::node::{LEAF_BIT, LightNode, NO_PARENT};
 use crate::math::Aabb;
 use crate::persist::{Kind, LoadError, Reader, Writer};

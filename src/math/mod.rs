@@ -20,6 +20,6 @@ pub(crate) use descent::pmf_to_f32;
 pub(crate) use sphere_map::SPHERE_MAP_JACOBIAN;
 pub(crate) use sphere_map::unit_direction;
 pub use sphere_map::{canonical_to_dir, dir_to_canonical};
-pub use sum::Accumulation;
 pub(crate) use sum::ACCUMULATION;
+pub use sum::Accumulation;
 pub(crate) use sum::SumBuffer;

@@ -264,7 +264,11 @@ impl<'a> Reader<'a> {
 
     /// A vector written by [`Writer::vec3`] (not checked).
     pub(crate) fn vec3(&mut self, field: &'static str) -> Result<glam::Vec3, LoadError> {
-        Ok(glam::Vec3::new(self.f32(field)?, self.f32(field)?, self.f32(field)?))
+        Ok(glam::Vec3::new(
+            self.f32(field)?,
+            self.f32(field)?,
+            self.f32(field)?,
+        ))
     }
 
     /// A value that `ok` accepts, else [`LoadError::Invalid`].

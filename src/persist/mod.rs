@@ -45,7 +45,6 @@ pub use error::LoadError;
 pub use io::{read_from, write_to};
 pub(crate) use tags::{tag, untag};
 
-
 /// The format version this build writes (and the newest it reads). It
 /// changes whenever any payload's layout changes; a build reads every
 /// version up to its own.

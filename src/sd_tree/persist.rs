@@ -7,12 +7,12 @@ use super::config::SdTreeConfig;
 use super::fraction::{FRACTION_SUMS, FractionLearner};
 use super::state::SdState;
 use crate::dropped::DropCounters;
+use crate::math::ACCUMULATION;
 use crate::math::SumBuffer;
 use crate::persist::{Kind, LoadError, Reader, Writer, tag, untag};
-use crate::math::ACCUMULATION;
-use crate::spatial::FILTERS;
 use crate::quadtree::{DirectionalFilter, DirectionalTree, QuadtreeConfig};
 use crate::spatial::BinaryTree;
+use crate::spatial::FILTERS;
 use alloc::vec::Vec;
 
 const DIRECTIONAL: [DirectionalFilter; 2] = [DirectionalFilter::Nearest, DirectionalFilter::Box];

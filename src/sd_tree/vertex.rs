@@ -20,7 +20,8 @@ pub(crate) trait RadianceCells {
 impl RadianceCells for SdTree {
     #[inline]
     fn record_radiance(&self, at: Located, dir: Vec3, radiance: f32, pdf: f32) -> RecordOutcome {
-        self.state.record_radiance(&self.tree, at, dir, radiance, pdf)
+        self.state
+            .record_radiance(&self.tree, at, dir, radiance, pdf)
     }
 }
 
@@ -57,8 +58,18 @@ impl core::fmt::Debug for DirectionVertex<'_> {
 impl<'a> DirectionVertex<'a> {
     /// The vertex at `p`, located at `at` in the spatial tree of `cells`.
     #[inline]
-    pub(crate) fn new(state: &'a SdState, cell: &'a SdCell, at: Located, cells: &'a dyn RadianceCells) -> Self {
-        Self { state, cell, at, cells }
+    pub(crate) fn new(
+        state: &'a SdState,
+        cell: &'a SdCell,
+        at: Located,
+        cells: &'a dyn RadianceCells,
+    ) -> Self {
+        Self {
+            state,
+            cell,
+            at,
+            cells,
+        }
     }
 
     /// The point this vertex was located from.

@@ -53,8 +53,8 @@ pub use cell_id::CellId;
 
 /// A point and where a spatial tree located it: the cell and its bounds.
 pub(crate) type Located = (glam::Vec3, (CellId, crate::math::Aabb));
-pub use filter::SpatialFilter;
 pub(crate) use filter::FILTERS;
+pub use filter::SpatialFilter;
 pub(crate) use jitter::{direction_salt, record_offset};
 pub use refine::RefineOutcome;
 pub use root_cube::SpatialError;
