@@ -72,42 +72,88 @@ impl LightCone {
     /// The smallest cone (in pbrt-v4's construction) that bounds both: the
     /// normal cones are merged and the larger `theta_e` is kept.
     pub fn union(&self, other: &Self) -> Self {
-        let cos_theta_e = self.cos_theta_e.min(other.cos_theta_e);
-        let sphere = Self {
-            cos_theta_e,
-            ..Self::SPHERE
-        };
+        self.union_with_angles(self.theta_o(), other, other.theta_o())
+            .0
+    }
+
+    /// [`LightCone::union`] (the same operations, the same result bits)
+    /// with each cone's [`LightCone::theta_o`] passed in rather than
+    /// recomputed; returns the union and its `theta_o`. The light tree's
+    /// builder merges a cone per emitter and axis, mostly equal or nested
+    /// ones, and keeping the angles beside the cones saves every `acos`.
+    #[inline]
+    pub(crate) fn union_with_angles(
+        &self,
+        theta_a: f32,
+        other: &Self,
+        theta_b: f32,
+    ) -> (Self, f32) {
         if self.is_sphere() || other.is_sphere() {
-            return sphere;
+            let cos_theta_e = self.cos_theta_e.min(other.cos_theta_e);
+            // A sphere's angle is `safe_acos(-1)`, as `theta_o()` computes
+            // it; pass it on rather than assume it equals `PI`.
+            let theta = if self.is_sphere() { theta_a } else { theta_b };
+            return (
+                Self {
+                    cos_theta_e,
+                    ..Self::SPHERE
+                },
+                theta,
+            );
         }
-        let theta_a = self.theta_o();
-        let theta_b = other.theta_o();
+        if self == other {
+            // angle_between(x, x) == 0, so the union is `self`.
+            return (*self, theta_a);
+        }
+        self.union_general(theta_a, other, theta_b)
+    }
+
+    /// [`LightCone::union_with_angles`] of two different cones, neither the
+    /// sphere (kept out of line: the builder's hot loop mostly takes the
+    /// two shortcuts).
+    #[inline(never)]
+    fn union_general(&self, theta_a: f32, other: &Self, theta_b: f32) -> (Self, f32) {
+        let cos_theta_e = self.cos_theta_e.min(other.cos_theta_e);
+        let sphere = || {
+            let c = Self {
+                cos_theta_e,
+                ..Self::SPHERE
+            };
+            (c, safe_acos(c.cos_theta_o))
+        };
         let theta_d = angle_between(self.axis, other.axis);
         if (theta_d + theta_b).min(PI) <= theta_a {
-            return Self {
-                cos_theta_e,
-                ..*self
-            };
+            return (
+                Self {
+                    cos_theta_e,
+                    ..*self
+                },
+                theta_a,
+            );
         }
         if (theta_d + theta_a).min(PI) <= theta_b {
-            return Self {
-                cos_theta_e,
-                ..*other
-            };
+            return (
+                Self {
+                    cos_theta_e,
+                    ..*other
+                },
+                theta_b,
+            );
         }
         let theta_o = (theta_a + theta_d + theta_b) * 0.5;
         if theta_o >= PI {
-            return sphere;
+            return sphere();
         }
         let Some(wr) = self.axis.cross(other.axis).try_normalize() else {
-            return sphere;
+            return sphere();
         };
         let axis = Quat::from_axis_angle(wr, theta_o - theta_a) * self.axis;
-        Self {
+        let c = Self {
             axis: axis.normalize_or(Vec3::Z),
             cos_theta_o: cos(theta_o),
             cos_theta_e,
-        }
+        };
+        (c, safe_acos(c.cos_theta_o))
     }
 }
 

@@ -6,7 +6,10 @@
 //! scratch, and the cheapest split wins (ties towards balanced counts, the
 //! first axis and boundary among equals). No pass shares work with another.
 
-use super::{Aabb, BUCKETS, BuildHeuristic, Item, OrientationMemo, bucket_of, m_omega};
+use super::binned::{BUCKETS, bucket_of};
+use super::heuristic::{BuildHeuristic, OrientationMemo, m_omega};
+use super::items::Item;
+use crate::math::Aabb;
 use crate::math::LightCone;
 use alloc::vec::Vec;
 
