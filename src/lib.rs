@@ -90,7 +90,7 @@
 //! | a light's power ([`Emitter::power`], [`Emitters::power`]) | its flux, one scalar (the luminance of an RGB power, or any fixed positive weighting), the same unit for every kind: a point light of intensity `I`, `4 pi I`; a spot light of peak intensity `I`, `4 pi I` too (pbrt-v4's convention: a point light as bright, its cone bounds where it shines; [`Emitter::spot`]); a one-sided Lambertian area light of radiance `L` and area `A`, `pi L A` (two-sided: `2 pi L A`); a sphere of radius `r`, `4 pi^2 r^2 L`; textured emission: the integral of `pi L` over the surface (per side) |
 //! | sun, sky and other lights with no position | not emitters: [`UnboundedLights`] with their number and the probability they share; `0.25` shared is what the render example uses beside many lights (for the GLT it is only the prior's share and the defensive floor, each cell learns its own); pbrt-v4's fixed choice uses `count / (count + 1)` |
 //! | which normal ([`ShadingContext::on_surface`]) | the shading normal, the one in the cosine of the estimate; its sign does not matter; none ([`ShadingContext::at`]) in media |
-//! | what a light sample records ([`LightVertex::record_light`]) | `luminance(Le) * factor` with the [`DirectLight`] factor of its convention: the light's arriving radiance, not times the BSDF and cosine, MIS-weighted and divided by the pdf; [`DirectLight::estimate`] gives the contribution and the record from one call, for pbrt-v4's or pbrt-v3's convention ([`Convention`]) |
+//! | what a light sample records ([`LightVertex::record_light`]) | [`luminance`]`(Le) * factor` with the [`DirectLight`] factor of its convention: the light's arriving radiance, not times the BSDF and cosine, MIS-weighted and divided by the pdf; [`DirectLight::estimate`] gives the contribution and the record from one call, for pbrt-v4's or pbrt-v3's convention ([`Convention`]) |
 //! | random numbers for a record | none: the stochastic box filter (off by default for light records) takes its offset from a hash of the record (`src/spatial/jitter.rs`), so the same records learn the same state on any thread count |
 //! | an occluded sample, a light behind the surface, a BSDF that is zero (and the shadow ray skipped) | record 0 or nothing, never a shadow ray for the record's sake: a zero adds nothing to what is learned; it only counts as a sample for the split and refinement rules, which then follow where paths go rather than where light arrives |
 //! | when to call `refine` | after each of PPG's doubling iterations ([`Iterations`]); a renderer that renders each tile to completion, after every wave of tiles (as many as it has threads): a GLT cell refines once it holds 3/2 of its records before ([`Glt::refine`]) |
@@ -203,7 +203,7 @@ pub use glam;
 // The lights and the shading point.
 pub use emitter::{Emitter, Emitters};
 pub use light_tree::{BuildError, BuildHeuristic, LightHierarchy, LightTree};
-pub use math::{Aabb, Accumulation};
+pub use math::{Aabb, Accumulation, luminance};
 // Choosing lights.
 pub use light_sampler::{LightId, LightSample, LightSampler, ShadingContext, UnboundedLights};
 pub use strategy::Strategy;

@@ -6,7 +6,7 @@
 //! The heuristics take the pdfs of the two techniques for the same sample,
 //! in the same measure (solid angle).
 
-use crate::path_recorder::luminance;
+use crate::math::luminance;
 use glam::Vec3;
 
 /// Veach's power heuristic (beta = 2), the weight of technique `a` against

@@ -28,16 +28,10 @@
 //! renderer makes them where it finds direct light, through the vertex's
 //! [`LightVertex::record_light`](crate::LightVertex::record_light).
 
+use crate::math::luminance;
 use crate::sd_tree::DirectionVertex;
 use alloc::vec::Vec;
 use glam::Vec3;
-
-/// The luminance of linear Rec. 709 RGB, the scalar the recorder delivers
-/// radiance as (`0.2126 r + 0.7152 g + 0.0722 b`).
-#[inline]
-pub fn luminance(c: Vec3) -> f32 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
-}
 
 /// One scattering of a path: where it left from, in which direction, with
 /// which pdfs and throughput factor, and (after [`PathRecorder::finish`])

@@ -7,8 +7,8 @@ mod common;
 
 use common::{DirectionsAt, Rand};
 use glam::Vec3;
+use guiding::luminance;
 use guiding::math::{Aabb, Accumulation};
-use guiding::path_recorder::luminance;
 use guiding::sd_tree::{SdTree, SdTreeConfig};
 use guiding::{PathRecorder, ShadingContext, mis};
 

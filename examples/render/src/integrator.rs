@@ -8,12 +8,12 @@
 
 use crate::bvh::Hit;
 use crate::geometry::{NO_EMITTER, offset_origin};
-use crate::lights::luminance;
 use crate::rng::Sampler;
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 use guiding::field::GuidingField;
 use guiding::glt::Glt;
+use guiding::luminance;
 use guiding::mis::Convention;
 use guiding::resampling::{Evaluated, resample};
 use guiding::sd_tree::SdTree;

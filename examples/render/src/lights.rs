@@ -70,12 +70,6 @@ pub struct LightPoint {
     pub radiance: Vec3,
 }
 
-/// Rec. 709 luminance.
-#[inline]
-pub fn luminance(c: Vec3) -> f32 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
-}
-
 impl Light {
     /// Its kind.
     pub fn kind(&self) -> LightKind {
@@ -99,7 +93,7 @@ impl Light {
     /// Lambertian planes, 4 pi^2 r^2 Le for spheres, with Le's luminance),
     /// area and emission cone.
     pub fn to_emitter(self) -> Emitter {
-        let le = luminance(self.radiance).max(0.0);
+        let le = guiding::luminance(self.radiance).max(0.0);
         let power = PI * le * self.area();
         match self.shape {
             LightShape::Quad { corner, e1, e2 } => {

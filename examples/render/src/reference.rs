@@ -248,7 +248,7 @@ pub fn load_or_render(
 
 fn mean_luminance(px: &[Vec3]) -> f64 {
     px.iter()
-        .map(|p| f64::from(crate::lights::luminance(*p)))
+        .map(|p| f64::from(guiding::luminance(*p)))
         .sum::<f64>()
         / px.len().max(1) as f64
 }

@@ -4,13 +4,13 @@
 //! iterations by inverse variance, as PPG does.
 
 use crate::integrator::{Guides, Recorder, radiance};
-use crate::lights::luminance;
 use crate::methods::{GuideParams, Method, fixed_sampler, new_field, new_glt, new_sd_tree};
 use crate::rng::Sampler;
 use crate::scene::Scene;
 use glam::Vec3;
 use guiding::field::GuidingField;
 use guiding::glt::Glt;
+use guiding::luminance;
 use guiding::schedule::{
     InverseVarianceCombiner, Iteration, PassStats, next_iteration, next_iteration_by_time,
 };

@@ -68,7 +68,7 @@ impl Moments {
         let l64 = l.as_dvec3();
         self.sum += l64;
         self.sum_sq += l64 * l64;
-        let y = f64::from(crate::lights::luminance(l));
+        let y = f64::from(guiding::luminance(l));
         self.lum += y;
         self.lum_sq += y * y;
     }

@@ -6,7 +6,7 @@
 //! it is. It runs the `render` binary's own library, so it exercises
 //! exactly the code the binary runs.
 
-use guiding_render::{lights, methods, metrics, reference, run, scene, scenes, tiles};
+use guiding_render::{methods, metrics, reference, run, scene, scenes, tiles};
 
 use guiding::cut::{BelowCut, CutConfig};
 use methods::{GuideParams, Method};
@@ -30,7 +30,7 @@ fn region_means(r: &Rendered) -> Vec<(f64, f64)> {
             for y in y0..y1 {
                 for x in x0..x1 {
                     let i = y * w + x;
-                    sum += f64::from(lights::luminance(r.image[i]));
+                    sum += f64::from(guiding::luminance(r.image[i]));
                     // Variance of a luminance: the channels' variances with
                     // squared weights (their covariance ignored, which only
                     // matters little for a tolerance of several sigma).

@@ -12,7 +12,7 @@ mod brute_force;
 mod shading_points;
 #[path = "../src/bin/light_limit/variance.rs"]
 mod variance;
-use guiding_render::{geometry, lights, materials, rng, scene, scenes};
+use guiding_render::{geometry, materials, rng, scene, scenes};
 
 use brute_force::PointTerms;
 

@@ -3,11 +3,11 @@
 //! traced into the scene.
 
 use crate::geometry::{NO_EMITTER, offset_origin};
-use crate::lights::luminance;
 use crate::rng::Sampler;
 use crate::scene::Scene;
 use crate::shading_points::ShadingPoint;
 use guiding::LightId;
+use guiding::luminance;
 use std::collections::HashMap;
 
 /// One light sample of the estimator's next-event part, kept where it

@@ -33,7 +33,7 @@ mod glt_variant;
 mod per_point_m;
 mod shading_points;
 mod variance;
-use guiding_render::{geometry, lights, materials, methods, rng, run, scene, scenes};
+use guiding_render::{geometry, materials, methods, rng, run, scene, scenes};
 
 use brute_force::PointTerms;
 use clap::Parser;
