@@ -62,7 +62,7 @@
 //! | the tables every cut reads (`CutRules`) | `src/cut/cut_rules.rs` |
 //! | a path's radiance records | `src/path_recorder.rs` |
 //! | the save format and its checks | `src/persist/`, `docs/format.md` |
-//! | light-tree build heuristics | `src/light_tree/build.rs` |
+//! | light-tree build heuristics | `src/light_tree/build/heuristic.rs` (the binned split: `build/binned.rs`) |
 //! | the importance of a light cluster | `src/light_sampler/importance.rs` |
 //! | the same, from decoded nodes in `f32` (the GLT's importance rules) | `src/cut/importance_table.rs` |
 //! | the one-number descent | `src/math/descent.rs` |
@@ -87,7 +87,7 @@
 //!
 //! | question | answer |
 //! | --- | --- |
-//! | a light's power ([`Emitter::power`], [`Emitters::power`]) | its flux, one scalar (the luminance of an RGB power, or any fixed positive weighting), the same unit for every kind: a point light of intensity `I`, `4 pi I`; a spot light of peak intensity `I`, `4 pi I` too (pbrt-v4's convention: a point light as bright, its cone bounds where it shines; [`Emitter::spot`]); a one-sided Lambertian area light of radiance `L` and area `A`, `pi L A` (two-sided: `2 pi L A`); a sphere of radius `r`, `4 pi^2 r^2 L`; textured emission: the integral of `pi L` over the surface (per side) |
+//! | a light's power ([`Emitter::power`], [`Emitters::power`]) | its flux, one scalar (the [`luminance`] of an RGB power, or any fixed positive weighting), the same unit for every kind: a point light of intensity `I`, `4 pi I`; a spot light of peak intensity `I`, `4 pi I` too (pbrt-v4's convention: a point light as bright, its cone bounds where it shines; [`Emitter::spot`]); a one-sided Lambertian area light of radiance `L` and area `A`, `pi L A` (two-sided: `2 pi L A`); a sphere of radius `r`, `4 pi^2 r^2 L`; textured emission: the integral of `pi L` over the surface (per side) |
 //! | sun, sky and other lights with no position | not emitters: [`UnboundedLights`] with their number and the probability they share; `0.25` shared is what the render example uses beside many lights (for the GLT it is only the prior's share and the defensive floor, each cell learns its own); pbrt-v4's fixed choice uses `count / (count + 1)` |
 //! | which normal ([`ShadingContext::on_surface`]) | the shading normal, the one in the cosine of the estimate; its sign does not matter; none ([`ShadingContext::at`]) in media |
 //! | what a light sample records ([`LightVertex::record_light`]) | [`luminance`]`(Le) * factor` with the [`DirectLight`] factor of its convention: the light's arriving radiance, not times the BSDF and cosine, MIS-weighted and divided by the pdf; [`DirectLight::estimate`] gives the contribution and the record from one call, for pbrt-v4's or pbrt-v3's convention ([`Convention`]) |
