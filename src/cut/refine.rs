@@ -512,7 +512,7 @@ mod tests {
 
     /// The stored `p_left` is the weights' ratio, or with importances the
     /// ratio of the learned factors `weight / importance`; where those
-    /// overflow, the weights' ratio.
+    /// overflow or underflow, the weights' ratio.
     #[test]
     fn p_left_is_the_ratio_of_the_learned_factors() {
         assert_eq!(stored_p_left((1.0, 3.0), None), 0.25);
@@ -520,6 +520,8 @@ mod tests {
         assert_eq!(stored_p_left((1.0, 3.0), Some((1.0, 1.0))), 0.25);
         assert_eq!(stored_p_left((3.0, 1.0), Some((1.0, 9.0))), 27.0 / 28.0);
         assert_eq!(stored_p_left((1e300, 3e300), Some((1e-300, 1.0))), 0.25);
+        // Factors that underflow to 0 (a sum of 0, not NaN): the weights.
+        assert_eq!(stored_p_left((1e-300, 3e-300), Some((1e300, 1e300))), 0.25);
     }
 
     /// [`CutRules::growth`] with nothing learned from emitters (only an
