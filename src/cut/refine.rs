@@ -346,6 +346,7 @@ mod tests {
     use crate::emitter::Emitter;
     use crate::light_sampler::{LightId, UnboundedLights};
     use crate::light_tree::{BuildHeuristic, LightTree};
+    use crate::record::RecordOutcome;
     use glam::Vec3;
 
     /// What [`CutRules::growth`] predicts is what the refinement builds:
@@ -554,9 +555,11 @@ mod tests {
     }
 
     /// Records on lights without power (a renderer's power estimate can
-    /// be 0 where its emission is not): the cluster they fill is not
-    /// split (neither child can take a weight), so no cut node gets a
-    /// `p_left` of `0 / 0`.
+    /// be 0 where its emission is not) are dropped, so a dark cluster never
+    /// holds a weight to split (neither child could take it) and no cut
+    /// node gets a `p_left` of `0 / 0`. (The rebuild's `sum > 0` guard on
+    /// such a split cannot be reached through records: its `>=` mutant is
+    /// equivalent.)
     #[test]
     fn records_on_dark_lights_split_nothing_dark() {
         let lights = [
@@ -572,12 +575,22 @@ mod tests {
         };
         let guide = CutRules::new(&tree, config).unwrap();
         let mut cut = guide.new_cut();
-        for k in 0..4000u32 {
-            guide.splat(&cut, LightId::Emitter(k % 4), 1.0);
-        }
-        guide.refine(&mut cut);
-        for node in &cut.nodes {
-            assert!((0.0..=1.0).contains(&node.p_left()), "{node:?}");
+        // The first refinement ends the cut at the dark cluster (the prior
+        // gives it nothing); the second finds it holding records.
+        for round in 0..2 {
+            for k in 0..4000u32 {
+                let outcome = guide.splat(&cut, LightId::Emitter(k % 4), 1.0);
+                let dark = k % 4 >= 2;
+                assert_eq!(outcome == RecordOutcome::Dropped, dark, "light {}", k % 4);
+            }
+            guide.refine(&mut cut);
+            assert!(!cut.nodes.is_empty());
+            for node in &cut.nodes {
+                assert!(
+                    (0.0..=1.0).contains(&node.p_left()),
+                    "round {round}: {node:?}"
+                );
+            }
         }
     }
 }
