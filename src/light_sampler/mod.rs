@@ -44,8 +44,10 @@ pub(crate) use crate::math::pmf_to_f32;
 /// lights, `Unbounded(i)` is the `i`-th). Both directions of the mapping
 /// are then an index: a sampled id names the renderer's light, and a light
 /// a BSDF sample hit names its id for the MIS pmf. A renderer whose lights
-/// sit in one mixed list stores each light's `LightId` beside it and the
-/// two index lists back (pbrt keeps such a map for the same purpose).
+/// sit in one list, the emitters first, maps with [`LightId::index`] and
+/// [`LightId::from_index`]; one whose list is mixed stores each light's
+/// `LightId` beside it and the two index lists back (pbrt keeps such a map
+/// for the same purpose).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum LightId {
     /// Emitter `i` of the scene's [`crate::Emitters`].
@@ -53,6 +55,35 @@ pub enum LightId {
     /// Unbounded light `i` (see [`UnboundedLights`]), handled beside the
     /// emitters.
     Unbounded(u32),
+}
+
+impl LightId {
+    /// The light's place in one list of a scene's lights that holds its
+    /// `emitters` emitters first, then its unbounded lights: `Emitter(i)` is
+    /// `i`, `Unbounded(i)` is `emitters + i` (saturating at `u32::MAX`).
+    ///
+    /// ```
+    /// use guiding::LightId;
+    /// assert_eq!(LightId::Unbounded(1).index(10), 11);
+    /// assert_eq!(LightId::from_index(11, 10), LightId::Unbounded(1));
+    /// assert_eq!(LightId::from_index(9, 10), LightId::Emitter(9));
+    /// ```
+    #[inline]
+    pub fn index(self, emitters: u32) -> u32 {
+        match self {
+            Self::Emitter(i) => i,
+            Self::Unbounded(i) => emitters.saturating_add(i),
+        }
+    }
+
+    /// The light at `index` of such a list ([`LightId::index`]).
+    #[inline]
+    pub fn from_index(index: u32, emitters: u32) -> Self {
+        match index.checked_sub(emitters) {
+            Some(i) => Self::Unbounded(i),
+            None => Self::Emitter(index),
+        }
+    }
 }
 
 /// A chosen light and the probability it was chosen with.
@@ -170,3 +201,24 @@ macro_rules! forward_sampler {
 }
 
 forward_sampler!(&S, alloc::boxed::Box<S>);
+
+#[cfg(test)]
+mod tests {
+    use super::LightId;
+
+    /// One list, emitters first: every place maps to one light and back,
+    /// at the boundary too (place `emitters` is the first unbounded light;
+    /// a `>` for `>=` there would make it an emitter past the last).
+    #[test]
+    fn one_list_maps_both_ways() {
+        for emitters in [0u32, 1, 5, u32::MAX - 2] {
+            for index in [0u32, 1, 4, 5, 6, emitters, emitters.saturating_add(1), u32::MAX] {
+                let id = LightId::from_index(index, emitters);
+                assert_eq!(id.index(emitters), index, "{index} of {emitters}");
+                let emitter = index < emitters;
+                assert_eq!(matches!(id, LightId::Emitter(_)), emitter, "{index} of {emitters}");
+            }
+        }
+        assert_eq!(LightId::Unbounded(5).index(u32::MAX - 2), u32::MAX);
+    }
+}
