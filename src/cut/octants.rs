@@ -37,6 +37,16 @@ impl OctantSplats {
         Self(counts.map(Counter::with))
     }
 
+    /// `total` splats of unknown octants spread as evenly as counts can
+    /// be: each octant `total / 8`, the first `total % 8` one more (what
+    /// saves of format versions 1 and 2, which kept one count per cell,
+    /// load as).
+    pub(crate) fn spread(total: u64) -> Self {
+        Self::with(core::array::from_fn(|o| {
+            total / 8 + u64::from((o as u64) < total % 8)
+        }))
+    }
+
     /// Counts a splat from `octant`.
     #[inline]
     pub(crate) fn count(&self, octant: usize) {
@@ -115,6 +125,23 @@ impl OctantSplats {
 
 #[cfg(test)]
 mod tests {
+    /// A total spreads evenly, the remainder to the first octants, and
+    /// nothing is lost or made up.
+    #[test]
+    fn a_total_spreads_evenly() {
+        assert_eq!(OctantSplats::spread(20).get(), [3, 3, 3, 3, 2, 2, 2, 2]);
+        assert_eq!(OctantSplats::spread(7).get(), [1, 1, 1, 1, 1, 1, 1, 0]);
+        assert_eq!(OctantSplats::spread(16).get(), [2; 8]);
+        assert_eq!(OctantSplats::spread(0).get(), [0; 8]);
+        for total in [1u64, 9, 1001, u64::MAX] {
+            let counts = OctantSplats::spread(total).get();
+            assert_eq!(
+                counts.iter().map(|&c| c as u128).sum::<u128>(),
+                total as u128
+            );
+        }
+    }
+
     use super::*;
 
     #[test]

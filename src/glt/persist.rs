@@ -83,9 +83,7 @@ impl<H: LightHierarchy> Glt<H> {
                 // part in every refinement.
                 let splats = r.u64("cell: splats")?;
                 r.u64("cell: split count")?;
-                let octants = OctantSplats::with(core::array::from_fn(|o| {
-                    splats / 8 + u64::from((o as u64) < splats % 8)
-                }));
+                let octants = OctantSplats::spread(splats);
                 return Ok(GltCell::with_counts(cut, octants, 0, iteration));
             }
             let octants = OctantSplats::read(r, "cell: octant splats")?;

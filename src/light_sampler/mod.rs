@@ -212,11 +212,24 @@ mod tests {
     #[test]
     fn one_list_maps_both_ways() {
         for emitters in [0u32, 1, 5, u32::MAX - 2] {
-            for index in [0u32, 1, 4, 5, 6, emitters, emitters.saturating_add(1), u32::MAX] {
+            for index in [
+                0u32,
+                1,
+                4,
+                5,
+                6,
+                emitters,
+                emitters.saturating_add(1),
+                u32::MAX,
+            ] {
                 let id = LightId::from_index(index, emitters);
                 assert_eq!(id.index(emitters), index, "{index} of {emitters}");
                 let emitter = index < emitters;
-                assert_eq!(matches!(id, LightId::Emitter(_)), emitter, "{index} of {emitters}");
+                assert_eq!(
+                    matches!(id, LightId::Emitter(_)),
+                    emitter,
+                    "{index} of {emitters}"
+                );
             }
         }
         assert_eq!(LightId::Unbounded(5).index(u32::MAX - 2), u32::MAX);
