@@ -125,6 +125,8 @@ impl OctantSplats {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+
     /// A total spreads evenly, the remainder to the first octants, and
     /// nothing is lost or made up.
     #[test]
@@ -141,8 +143,6 @@ mod tests {
             );
         }
     }
-
-    use super::*;
 
     #[test]
     fn a_point_counts_in_its_octant() {
