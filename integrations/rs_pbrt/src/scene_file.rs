@@ -109,10 +109,11 @@ impl Params {
             .and_then(|v| v.first().copied())
             .unwrap_or(default)
     }
-    fn rgb(&self, name: &str) -> Spectrum {
+    /// An `rgb` parameter, or pbrt's default `default` (grey) without one.
+    fn rgb(&self, name: &str, default: f32) -> Spectrum {
         match self.floats(name).as_deref() {
             Some([r, g, b]) => Spectrum::rgb(*r, *g, *b),
-            _ => Spectrum::new(1.0),
+            _ => Spectrum::new(default),
         }
     }
     fn point(&self, name: &str, default: [f32; 3]) -> Point3f {
@@ -273,9 +274,9 @@ pub fn load(path: &std::path::Path) -> Result<Loaded, String> {
             }
             ("Sampler", _) => spp = params.float("pixelsamples", 16.0) as u32,
             ("Integrator", _) => max_depth = params.float("maxdepth", 5.0) as u32,
-            ("Material", "matte") => state.material = matte(params.rgb("Kd")),
+            ("Material", "matte") => state.material = matte(params.rgb("Kd", 0.5)),
             ("AreaLightSource", "diffuse") => {
-                state.area_light = Some((params.rgb("L"), params.flag("twosided")))
+                state.area_light = Some((params.rgb("L", 1.0), params.flag("twosided")))
             }
             ("LightSource", light) => {
                 let (t, mi) = (&state.transform, MediumInterface::default());
@@ -287,7 +288,7 @@ pub fn load(path: &std::path::Path) -> Result<Loaded, String> {
                     "point" => Light::Point(Box::new(PointLight::new(
                         &(*t * Transform::translate(&vector(from))),
                         &mi,
-                        &params.rgb("I"),
+                        &params.rgb("I", 1.0),
                     ))),
                     "spot" => {
                         let dir = Transform::look_at(
@@ -307,19 +308,19 @@ pub fn load(path: &std::path::Path) -> Result<Loaded, String> {
                         Light::Spot(Box::new(SpotLight::new(
                             &l2w,
                             &mi,
-                            &params.rgb("I"),
+                            &params.rgb("I", 1.0),
                             cone,
                             cone - delta,
                         )))
                     }
                     "distant" => Light::Distant(Box::new(DistantLight::new(
                         t,
-                        &params.rgb("L"),
+                        &params.rgb("L", 1.0),
                         &(from - to),
                     ))),
                     "infinite" => Light::InfiniteArea(Box::new(InfiniteAreaLight::new(
                         t,
-                        &params.rgb("L"),
+                        &params.rgb("L", 1.0),
                         1,
                         String::new(),
                     ))),
