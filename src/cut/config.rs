@@ -236,3 +236,53 @@ impl CutConfig {
         self.unbounded.validate()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The two presets set exactly their three rules and keep every other
+    /// field; importance is on by default and off under the paper's rules.
+    #[test]
+    fn presets_set_their_rules_and_keep_the_rest() {
+        let mine = CutConfig {
+            sigma: 0.3,
+            alpha: 0.4,
+            min_splats: 7,
+            visibility: true,
+            split_prior: SplitPrior::Power,
+            ..CutConfig::default()
+        };
+        let paper = mine.with_paper_rules();
+        assert_eq!(
+            (paper.modulation, paper.below_cut, paper.prior),
+            (Modulation::None, BelowCut::Power, Prior::Power)
+        );
+        assert!(!paper.uses_importance());
+        let back = paper.with_importance();
+        assert_eq!(back, mine, "the importance rules are the default's");
+        assert!(back.uses_importance());
+        assert_eq!(
+            (back.sigma, back.alpha, back.min_splats, back.visibility),
+            (0.3, 0.4, 7, true)
+        );
+        assert_eq!(back.split_prior, SplitPrior::Power);
+        // Each rule alone makes the configuration use importance.
+        for one in [
+            CutConfig {
+                modulation: Modulation::Importance,
+                ..paper
+            },
+            CutConfig {
+                below_cut: BelowCut::Importance,
+                ..paper
+            },
+            CutConfig {
+                prior: Prior::Importance,
+                ..paper
+            },
+        ] {
+            assert!(one.uses_importance(), "{one:?}");
+        }
+    }
+}
