@@ -259,6 +259,26 @@ pub fn load(path: &std::path::Path) -> Result<Loaded, String> {
                 }
                 _ => return Err(format!("{directive}: {name} has no value")),
             }
+            // Numbers must be finite numbers, triples come in threes: a
+            // bad file is an error naming the parameter, never a NaN.
+            let ty = decl.split_whitespace().next().unwrap_or("");
+            let numeric = [
+                "float", "integer", "rgb", "color", "point", "normal", "vector",
+            ];
+            if numeric.contains(&ty) {
+                if let Some(bad) = values
+                    .iter()
+                    .find(|v| !v.parse::<f32>().is_ok_and(f32::is_finite))
+                {
+                    return Err(format!("{directive}: {name}: not a finite number: {bad}"));
+                }
+                if ty != "float" && ty != "integer" && values.len() % 3 != 0 {
+                    return Err(format!(
+                        "{directive}: {name}: {} values, not triples",
+                        values.len()
+                    ));
+                }
+            }
             params.0.insert(name, values);
         }
         match (directive.as_str(), kind.as_str()) {
