@@ -191,7 +191,9 @@ def city():
 
 
 def tiny():
-    """The check mode's scene: one room, 12 lights, 32 x 24 pixels."""
+    """The check mode's scene: one room, 12 small spheres, a spot, a point
+    light and a sun (every kind of light the glue describes but emissive
+    triangles), 32 x 24 pixels."""
     rng = random.Random(4)
     out = ["# The --check scene: a box and 12 small lights (make_scenes.py)."]
     header(out, (0, 1, -3.5), (0, 1, 0), 60, (32, 24), "tiny", spp=4)
@@ -208,6 +210,8 @@ def tiny():
         p = (rng.uniform(-1.8, 1.8), rng.uniform(1.2, 1.9), rng.uniform(-1, 1.8))
         sphere_light(out, p, 0.05, (8, 7, 6))
     out.append('LightSource "distant" "point from" [0 0 0] "point to" [0.3 -1 0.2] "rgb L" [0.5 0.5 0.5]')
+    out.append('LightSource "spot" "point from" [1.5 1.8 -3] "point to" [0 0 0] "float coneangle" [25] "rgb I" [6 6 6]')
+    out.append('LightSource "point" "point from" [-1.5 1.5 -3] "rgb I" [1 1 1]')
     out.append("WorldEnd")
     return out
 
