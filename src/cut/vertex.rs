@@ -241,3 +241,40 @@ impl<H: LightHierarchy> LightSampler for LightVertex<'_, H> {
         self.rules.sample_with_visibility(self.cut, ctx, u)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    /// Records of different lights at one point take different
+    /// stochastic-box offsets (the salt names the light, emitter or
+    /// unbounded), so a point's records spread over the box's cells rather
+    /// than all landing in one; the same light at the same point, the same
+    /// offset (learning is independent of thread order).
+    #[test]
+    fn each_light_salts_its_own_offset() {
+        let ids = [
+            LightId::Emitter(0),
+            LightId::Emitter(1),
+            LightId::Emitter(2),
+            LightId::Unbounded(0),
+            LightId::Unbounded(1),
+        ];
+        let p = Vec3::new(0.25, -3.0, 7.5);
+        for (i, a) in ids.iter().enumerate() {
+            assert_eq!(
+                record_offset(p, light_salt(*a)),
+                record_offset(p, light_salt(*a))
+            );
+            for b in &ids[i + 1..] {
+                assert_ne!(light_salt(*a), light_salt(*b), "{a:?} {b:?}");
+                let (oa, ob) = (
+                    record_offset(p, light_salt(*a)),
+                    record_offset(p, light_salt(*b)),
+                );
+                assert_ne!(oa, ob, "{a:?} {b:?}");
+            }
+        }
+    }
+}
