@@ -224,7 +224,6 @@ fn radiance(
             let at = strategy.at(&isect);
             l += beta * direct(loaded, &isect, &at, rng);
         }
-        let bsdf = isect.bsdf.as_ref().expect("computed above");
         let (mut wi, mut pdf, mut sampled) = (Vector3f::default(), 0.0, 0u8);
         let wo = isect.common.wo;
         let f = bsdf.sample_f(

@@ -365,12 +365,15 @@ pub fn load(path: &std::path::Path) -> Result<Loaded, String> {
                     }
                     "trianglemesh" => {
                         let p = params.floats("P").ok_or("trianglemesh without P")?;
+                        // Read as integers: through `f32` an index past
+                        // 2^24 would round to another vertex.
                         let idx: Vec<u32> = params
-                            .floats("indices")
+                            .0
+                            .get("indices")
                             .ok_or("trianglemesh without indices")?
                             .iter()
-                            .map(|&x| x as u32)
-                            .collect();
+                            .map(|s| s.parse().map_err(|_| format!("trianglemesh: index {s}")))
+                            .collect::<Result<_, _>>()?;
                         let world: Vec<Point3f> = p
                             .chunks_exact(3)
                             .map(|c| {
