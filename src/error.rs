@@ -51,6 +51,10 @@ pub enum Error {
     /// [`Strategy::new`](crate::Strategy::new) was given a name it does
     /// not know.
     UnknownStrategy,
+    /// A guide was handed a light tree of another shape than the one it
+    /// learned over ([`Glt::set_light_tree`](crate::Glt::set_light_tree)):
+    /// other lights, another order, or a rebuild rather than a refit.
+    LightTreeShape,
 }
 
 impl From<ConfigError> for Error {
@@ -82,6 +86,10 @@ impl core::fmt::Display for Error {
                 "unknown light sampling strategy (expected one of {:?})",
                 crate::Strategy::NAMES
             ),
+            Self::LightTreeShape => f.write_str(
+                "the light tree has another shape than the one the guide learned over \
+                 (refit the guide's tree rather than rebuilding it)",
+            ),
         }
     }
 }
@@ -93,7 +101,7 @@ impl std::error::Error for Error {
             Self::Config(e) => Some(e),
             Self::Spatial(e) => Some(e),
             Self::Build(e) => Some(e),
-            Self::UnknownStrategy => None,
+            Self::UnknownStrategy | Self::LightTreeShape => None,
         }
     }
 }

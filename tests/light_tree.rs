@@ -934,3 +934,171 @@ mod props {
         }
     }
 }
+
+// ---------------------------------------------------------------------------
+// Refitting a built tree to lights that moved
+// ---------------------------------------------------------------------------
+
+/// The tree's shape: each node's children and emitter.
+fn shape(tree: &LightTree) -> Vec<(Option<[u32; 2]>, Option<u32>)> {
+    (0..tree.node_count() as u32)
+        .map(|n| (tree.children(n), tree.emitter(n)))
+        .collect()
+}
+
+/// `e` moved by `offset`, its power scaled by `scale` and its cone (if any)
+/// turned a little.
+fn moved(e: &Emitter, offset: Vec3, scale: f32, r: &mut Rand) -> Emitter {
+    let mut m = *e;
+    m.bounds = Aabb::new(e.bounds.min + offset, e.bounds.max + offset);
+    m.power *= scale;
+    if let Some(c) = &mut m.cone {
+        c.axis = (c.axis + r.dir() * 0.2).normalize();
+    }
+    m
+}
+
+#[test]
+fn refit_of_unmoved_emitters_is_bit_identical_to_the_build() {
+    let scene = mixed_scene(3000, 71);
+    for h in HEURISTICS {
+        let built = build(&scene, h);
+        let mut tree = built.clone();
+        assert_eq!(tree.refit(scene.as_slice()), Ok(1.0), "{h:?}");
+        assert_eq!(tree.nodes(), built.nodes(), "{h:?}");
+        assert_eq!(tree.to_bytes(), built.to_bytes(), "{h:?}");
+    }
+}
+
+#[test]
+fn refit_bounds_what_moved_and_keeps_the_shape() {
+    let scene = mixed_scene(3000, 72);
+    let mut r = Rand::new(73);
+    for h in HEURISTICS {
+        let built = build(&scene, h);
+        let mut tree = built.clone();
+        // Every light moves up to 5 in a 100 box, changes power by up to
+        // 4x either way, and some go dark or light up.
+        let frame: Vec<Emitter> = scene
+            .iter()
+            .map(|e| {
+                let scale = match r.below(20) {
+                    0 => 0.0,
+                    _ => 4f32.powf(r.range(-1.0, 1.0)),
+                };
+                moved(e, r.point(5.0), scale, &mut r)
+            })
+            .collect();
+        let ratio = tree.refit(frame.as_slice()).unwrap();
+        assert!(ratio.is_finite() && ratio > 0.0, "{h:?}: {ratio}");
+        check_tree(&tree, &frame);
+        assert_eq!(shape(&tree), shape(&built), "{h:?}");
+        assert_eq!(tree.depth(), built.depth());
+        // Moved back, the tree is the built one again, bit for bit.
+        assert_eq!(tree.refit(scene.as_slice()), Ok(1.0));
+        assert_eq!(tree.to_bytes(), built.to_bytes(), "{h:?}");
+    }
+}
+
+#[test]
+fn refit_works_at_any_depth_and_scale() {
+    // Deeper than 64 levels.
+    let chain = deep_chain(100);
+    let mut tree = build(&chain, BuildHeuristic::Sarh);
+    let shifted: Vec<Emitter> = chain
+        .iter()
+        .map(|e| Emitter {
+            bounds: Aabb::new(e.bounds.min + Vec3::Z, e.bounds.max + Vec3::Z),
+            ..*e
+        })
+        .collect();
+    tree.refit(shifted.as_slice()).unwrap();
+    check_tree(&tree, &shifted);
+    assert!(tree.depth() > 64);
+    // No emitters, one emitter, coincident emitters pulled apart (cost 0
+    // when built: any move is infinitely worse), and back together.
+    let mut empty = build(&[], BuildHeuristic::Sarh);
+    assert_eq!(empty.refit(&[] as &[Emitter]), Ok(1.0));
+    check_tree(&empty, &[]);
+    let one = [Emitter::point(Vec3::ONE, 2.0)];
+    let mut tree = build(&one, BuildHeuristic::Sarh);
+    let far = [Emitter::point(Vec3::splat(1e30), 3.0)];
+    assert_eq!(tree.refit(far.as_slice()), Ok(1.0));
+    check_tree(&tree, &far);
+    let together = vec![Emitter::point(Vec3::ONE, 1.0); 8];
+    let mut tree = build(&together, BuildHeuristic::Sarh);
+    let apart: Vec<Emitter> = (0..8)
+        .map(|i| Emitter::point(Vec3::new(i as f32, 0.0, 0.0), 1.0))
+        .collect();
+    assert_eq!(tree.refit(apart.as_slice()), Ok(f32::INFINITY));
+    check_tree(&tree, &apart);
+    assert_eq!(tree.refit(together.as_slice()), Ok(1.0));
+    check_tree(&tree, &together);
+}
+
+#[test]
+fn refit_cost_tells_a_small_move_from_a_scramble() {
+    let scene = mixed_scene(3000, 74);
+    let mut r = Rand::new(75);
+    for h in HEURISTICS {
+        let built = build(&scene, h);
+        let nudged: Vec<Emitter> = scene
+            .iter()
+            .map(|e| moved(e, r.point(0.5), 1.0, &mut r))
+            .collect();
+        let mut tree = built.clone();
+        let small = tree.refit(nudged.as_slice()).unwrap();
+        assert!(small < 1.1, "{h:?}: {small}");
+        // Every light somewhere else in the box: the clusters are spread
+        // over the whole scene.
+        let scrambled: Vec<Emitter> = scene
+            .iter()
+            .map(|e| {
+                let c = e.bounds.min * 0.5 + e.bounds.max * 0.5;
+                moved(e, r.point(50.0) - c, 1.0, &mut r)
+            })
+            .collect();
+        let big = tree.refit(scrambled.as_slice()).unwrap();
+        assert!(big > LightTree::REBUILD_RATIO, "{h:?}: {big}");
+    }
+}
+
+#[test]
+fn refit_errors_leave_the_tree_unchanged() {
+    let scene = mixed_scene(50, 76);
+    let tree = build(&scene, BuildHeuristic::Sarh);
+    let before = tree.to_bytes();
+    let mut t = tree.clone();
+    assert_eq!(
+        t.refit(&scene[..49]),
+        Err(BuildError::EmitterCount {
+            tree: 50,
+            given: 49
+        })
+    );
+    let mut bad = scene.clone();
+    bad[7].power = f32::NAN;
+    assert!(matches!(
+        t.refit(bad.as_slice()),
+        Err(BuildError::InvalidPower { emitter: 7, .. })
+    ));
+    let mut bad = scene.clone();
+    bad[3].bounds = Aabb::EMPTY;
+    assert_eq!(
+        t.refit(bad.as_slice()),
+        Err(BuildError::InvalidBounds { emitter: 3 })
+    );
+    let mut bad = scene.clone();
+    bad[0].power = f32::MAX;
+    bad[1].power = f32::MAX;
+    assert_eq!(t.refit(bad.as_slice()), Err(BuildError::PowerOverflow));
+    assert_eq!(t.to_bytes(), before);
+    assert!(
+        BuildError::EmitterCount {
+            tree: 50,
+            given: 49
+        }
+        .to_string()
+        .contains("50 emitters, 49")
+    );
+}

@@ -6,7 +6,7 @@ use super::guiding_cut::GuidingCut;
 use super::importance_table::ImportanceTable;
 use super::walk::WalkTable;
 use crate::error::ConfigError;
-use crate::light_tree::LightHierarchy;
+use crate::light_tree::{LightHierarchy, same_shape};
 use crate::math::Descent;
 use alloc::vec::Vec;
 
@@ -82,6 +82,11 @@ impl<H: LightHierarchy> CutRules<H> {
     /// invalid configuration ([`CutConfig::validate`]).
     pub fn new(tree: H, config: CutConfig) -> Result<Self, ConfigError> {
         config.validate()?;
+        Ok(Self::with_valid_config(tree, config))
+    }
+
+    /// [`CutRules::new`] for a `config` known to be valid.
+    fn with_valid_config(tree: H, config: CutConfig) -> Self {
         let lights = &tree;
         let split: Vec<f32> = (0..lights.node_count() as u32)
             .map(|n| match lights.children(n) {
@@ -96,14 +101,28 @@ impl<H: LightHierarchy> CutRules<H> {
             .uses_importance()
             .then(|| ImportanceTable::new(lights, WalkTable::pair_nodes(lights).into_iter()));
         let has_power = lights.root().is_some_and(|r| lights.power(r) > 0.0);
-        Ok(Self {
+        Self {
             tree,
             split,
             walk,
             importance,
             config,
             has_power,
-        })
+        }
+    }
+
+    /// Puts `tree` in place of the light hierarchy, which it must have the
+    /// shape of (a refit of it: the same nodes, links and emitter order),
+    /// and rebuilds the tables from its powers and bounds; returns the
+    /// hierarchy it replaces. Every cut over the old hierarchy is a valid
+    /// cut over the new one: cuts name nodes, not positions. `Err(tree)`,
+    /// and nothing changes, for another shape. O(nodes).
+    pub(crate) fn set_light_tree(&mut self, tree: H) -> Result<H, H> {
+        if !same_shape(&self.tree, &tree) {
+            return Err(tree);
+        }
+        let new = Self::with_valid_config(tree, self.config);
+        Ok(core::mem::replace(self, new).tree)
     }
 
     /// The light hierarchy.

@@ -206,6 +206,17 @@ impl<H: LightHierarchy> GuidingField<H> {
         self.guide.light_tree()
     }
 
+    /// Hands the field its light tree after a refit and returns the one it
+    /// held, keeping everything learned, as
+    /// [`Glt::set_light_tree`](crate::Glt::set_light_tree) does (the
+    /// directional quadtrees are untouched). [`Error::LightTreeShape`] for
+    /// a tree of another shape, and nothing changes.
+    pub fn set_light_tree(&mut self, lights: H) -> Result<H, Error> {
+        self.guide
+            .set_light_tree(lights)
+            .map_err(|_| Error::LightTreeShape)
+    }
+
     /// The guiding tree every cell's cut is used through.
     pub fn cut_rules(&self) -> &CutRules<H> {
         &self.guide

@@ -63,6 +63,42 @@ impl<H: LightHierarchy> Glt<H> {
         self.guide.light_tree()
     }
 
+    /// Hands the GLT its light tree after a refit
+    /// ([`LightTree::refit`](crate::LightTree::refit): the lights moved or
+    /// changed power, the tree kept its shape) and returns the one it
+    /// held. Everything learned is kept: each cell's cut names tree nodes,
+    /// which still hold the same lights; the power splits and importance
+    /// tables are rebuilt from the new tree, so sampling follows the
+    /// lights' new powers and bounds at once, and a light that was dark
+    /// and now shines is reachable through the prior. O(light-tree nodes).
+    /// [`Error::LightTreeShape`] for a tree of another shape (a rebuild,
+    /// other lights), and nothing changes.
+    ///
+    /// ```
+    /// # use guiding::{Aabb, BuildHeuristic, Emitter, Glt, GltConfig, LightTree};
+    /// # use guiding::glam::Vec3;
+    /// let mut lights: Vec<Emitter> = (0..8)
+    ///     .map(|i| Emitter::point(Vec3::new(i as f32, 1.0, 0.0), 1.0))
+    ///     .collect();
+    /// let tree = LightTree::build(lights.as_slice(), BuildHeuristic::default())?;
+    /// let scene = Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0));
+    /// let mut glt = Glt::new(tree, scene, GltConfig::default())?;
+    /// // ... render a frame, refine ...
+    /// for l in &mut lights {
+    ///     l.bounds = Aabb::from_point(l.bounds.min + Vec3::Y * 0.1);
+    /// }
+    /// let mut tree = glt.light_tree().clone();
+    /// let drift = tree.refit(lights.as_slice())?;
+    /// assert!(drift < LightTree::REBUILD_RATIO);
+    /// glt.set_light_tree(tree)?;
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn set_light_tree(&mut self, tree: H) -> Result<H, Error> {
+        self.guide
+            .set_light_tree(tree)
+            .map_err(|_| Error::LightTreeShape)
+    }
+
     /// The guiding tree every cell's cut is used through.
     pub fn cut_rules(&self) -> &CutRules<H> {
         &self.guide

@@ -1,7 +1,7 @@
 use core::fmt;
 
-/// Why a light tree could not be built. Every variant names the offending
-/// emitter so a renderer can report it.
+/// Why a light tree could not be built or refitted. Every variant about
+/// one emitter names it so a renderer can report it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 pub enum BuildError {
@@ -36,6 +36,14 @@ pub enum BuildError {
     },
     /// The total power does not fit in an `f32`.
     PowerOverflow,
+    /// [`LightTree::refit`](super::LightTree::refit) was given another
+    /// number of emitters than the tree holds.
+    EmitterCount {
+        /// The tree's emitters.
+        tree: usize,
+        /// How many were given.
+        given: usize,
+    },
 }
 
 impl fmt::Display for BuildError {
@@ -60,6 +68,10 @@ impl fmt::Display for BuildError {
                 )
             }
             Self::PowerOverflow => f.write_str("the total emitted power overflows f32"),
+            Self::EmitterCount { tree, given } => write!(
+                f,
+                "a refit needs the tree's {tree} emitters, {given} were given"
+            ),
         }
     }
 }

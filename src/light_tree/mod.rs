@@ -11,6 +11,7 @@ mod hierarchy;
 mod node;
 mod path;
 mod persist;
+mod shape;
 mod tree;
 
 pub use build::BuildHeuristic;
@@ -20,4 +21,6 @@ pub use node::LightNode;
 pub use path::EmitterPath;
 pub use persist::fingerprint;
 pub(crate) use persist::read_fingerprint;
+pub(crate) use shape::same_shape;
+pub use shape::shape_fingerprint;
 pub use tree::LightTree;

@@ -1,5 +1,5 @@
 use super::BuildError;
-use super::build::{BuildHeuristic, build};
+use super::build::{BuildHeuristic, build, cost, refit};
 use super::hierarchy::{LightHierarchy, NodeBounds};
 use super::node::{LEAF_BIT, LightNode, NO_PARENT};
 use crate::emitter::Emitters;
@@ -10,13 +10,18 @@ use alloc::vec::Vec;
 /// per leaf, 32 bytes per node (see `LightNode`) plus 4 bytes per emitter
 /// for its leaf.
 ///
-/// Built once from an [`Emitters`] list; immutable and `Sync` afterwards.
+/// Built once from an [`Emitters`] list and `Sync`; when the emitters move
+/// or change power (an animation's next frame), [`LightTree::refit`]
+/// updates it in place, keeping its shape (and so what the guides learned
+/// over it).
 #[derive(Clone, Debug)]
 pub struct LightTree {
     pub(super) nodes: Vec<LightNode>,
     pub(super) leaf_of: Vec<u32>,
     pub(super) scene: Aabb,
     pub(super) depth: usize,
+    /// The tree's cost (`build/refit.rs`) when it was built or loaded.
+    pub(super) built_cost: f32,
 }
 
 impl LightTree {
@@ -31,6 +36,37 @@ impl LightTree {
         heuristic: BuildHeuristic,
     ) -> Result<Self, BuildError> {
         build(emitters, heuristic)
+    }
+
+    /// A refit whose cost ratio ([`LightTree::refit`]) passes this is worth
+    /// a rebuild: past it, sampling from the refitted tree measurably
+    /// loses to sampling from a new one (docs/experiments/refit.md).
+    pub const REBUILD_RATIO: f32 = 1.5;
+
+    /// Updates the tree to `emitters` after they moved, turned or changed
+    /// power: the same count in the same order (emitter `i` stays on its
+    /// leaf), every bound, cone and power recomputed bottom-up over the
+    /// tree's shape, which is kept. O(n), no allocation beyond the
+    /// emitters' copy. The guides learned over the tree keep what they
+    /// learned: hand them the refitted tree
+    /// ([`Glt::set_light_tree`](crate::Glt::set_light_tree)).
+    ///
+    /// Returns how much the tree drifted: its cost (power-weighted spread
+    /// of its clusters in space and direction) over its cost when built, 1
+    /// when nothing moved. Past [`LightTree::REBUILD_RATIO`], build a new
+    /// tree (and start learning again). Errors as [`LightTree::build`]
+    /// does, and [`BuildError::EmitterCount`] for another number of
+    /// emitters; on an error the tree is unchanged.
+    pub fn refit<E: Emitters + ?Sized>(&mut self, emitters: &E) -> Result<f32, BuildError> {
+        let (nodes, scene) = refit(self, emitters)?;
+        self.nodes = nodes;
+        self.scene = scene;
+        let now = cost(&self.nodes, &self.scene);
+        Ok(match (now, self.built_cost) {
+            (now, built) if built > 0.0 => now / built,
+            (now, _) if now > 0.0 => f32::INFINITY,
+            _ => 1.0,
+        })
     }
 
     /// The nodes, root first, depth-first.

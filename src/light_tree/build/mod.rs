@@ -1,11 +1,14 @@
 //! Building the light tree: the emitters checked ([`items`]), split top-down
 //! with one of four heuristics ([`heuristic`], [`binned`]), aggregated
-//! bottom-up ([`cone_bound`]), then quantised into [`LightNode`]s.
+//! bottom-up ([`cone_bound`]), then quantised into [`LightNode`]s; and
+//! [`refit`], the same aggregation over a built tree's shape when its
+//! emitters move.
 
 mod binned;
 mod cone_bound;
 mod heuristic;
 mod items;
+mod refit;
 
 use super::node::{LEAF_BIT, LightNode, NO_PARENT, NodeData};
 use super::{BuildError, LightTree};
@@ -17,6 +20,7 @@ use cone_bound::ConeBound;
 pub use heuristic::BuildHeuristic;
 use heuristic::OrientationMemo;
 use items::{Item, validate};
+pub(super) use refit::{cost, refit};
 
 /// Exact (unquantised) data of a node while building.
 #[derive(Clone, Copy)]
@@ -70,6 +74,7 @@ fn build_with<E: Emitters + ?Sized>(
             leaf_of: Vec::new(),
             scene: Aabb::EMPTY,
             depth: 0,
+            built_cost: 0.0,
         });
     }
     // Past this depth, splits become medians: keeps the build O(n log n) and
@@ -137,8 +142,26 @@ fn build_with<E: Emitters + ?Sized>(
     }
     drop(items);
     drop(scratch);
+    let (nodes, scene) = aggregate_and_encode(&mut agg)?;
+    let built_cost = cost(&nodes, &scene);
+    Ok(LightTree {
+        nodes,
+        leaf_of,
+        scene,
+        depth,
+        built_cost,
+    })
+}
 
-    // Children come after their parent, so a reverse sweep aggregates.
+/// Aggregates the nodes bottom-up (each inner node's bounds, cone, sides
+/// and power from its two children; the leaves and every link filled in),
+/// then quantises them against the root's bounds: the end of a build and
+/// all of a refit. Children come after their parent, so one reverse sweep
+/// aggregates.
+fn aggregate_and_encode(agg: &mut [Aggregate]) -> Result<(Vec<LightNode>, Aabb), BuildError> {
+    if agg.is_empty() {
+        return Ok((Vec::new(), Aabb::EMPTY));
+    }
     for i in (0..agg.len()).rev() {
         if agg[i].link & LEAF_BIT != 0 {
             continue;
@@ -172,12 +195,7 @@ fn build_with<E: Emitters + ?Sized>(
             )
         })
         .collect();
-    Ok(LightTree {
-        nodes,
-        leaf_of,
-        scene,
-        depth,
-    })
+    Ok((nodes, scene))
 }
 
 /// Reorders `items` and returns where the right child starts (in
