@@ -1617,6 +1617,62 @@ fn shared_splats_anchor_where_they_came_from() {
     );
 }
 
+/// With the box filter a record's value is shared among the cells its box
+/// overlaps by the fraction each covers: the cells' sums add up to the
+/// value. A value so small that some cells' parts round to zero is still
+/// `Recorded` when any cell took a part.
+#[test]
+fn box_filter_shares_a_records_value_by_volume() {
+    use guiding::RecordOutcome;
+    use guiding::glt::{Glt, GltConfig};
+    use guiding::spatial::SpatialFilter;
+    let mut rng = Rand::new(13);
+    let lights = lights_in_box(&mut rng, 30, 8.0);
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let config = GltConfig {
+        light_filter: SpatialFilter::Box,
+        spatial_threshold: 200.0,
+        ..GltConfig::default()
+    };
+    let mut glt = Glt::new(&tree, common::scene(), config).unwrap();
+    for _ in 0..3 {
+        for _ in 0..3000 {
+            let p = rng.point(9.0);
+            glt.record_light_at(p, LightId::Emitter(rng.below(30)), 1.0);
+        }
+        glt.refine();
+    }
+    assert!(glt.memory().cells > 8);
+    let collected = |glt: &Glt<&LightTree>| -> (f64, usize) {
+        let sums = glt
+            .spatial()
+            .data_slice()
+            .iter()
+            .map(|c| c.cut().accumulated().0);
+        (sums.clone().sum(), sums.filter(|&s| s > 0.0).count())
+    };
+    let (mut shared, mut mixed) = (0, 0);
+    for _ in 0..300 {
+        let p = rng.point(9.0);
+        glt.clear_records();
+        glt.record_light_at(p, LightId::Emitter(4), 3.0);
+        let (total, overlapped) = collected(&glt);
+        assert!((total - 3.0).abs() < 1e-5, "{total} at {p}");
+        shared += usize::from(overlapped > 1);
+        glt.clear_records();
+        let tiny = f32::from_bits(1);
+        let outcome = glt.record_light_at(p, LightId::Emitter(4), tiny);
+        let (total, cells) = collected(&glt);
+        mixed += usize::from(cells > 0 && cells < overlapped);
+        let expected = match total > 0.0 {
+            true => RecordOutcome::Recorded,
+            false => RecordOutcome::Zero,
+        };
+        assert_eq!(outcome, expected, "at {p}");
+    }
+    assert!(shared > 100 && mixed > 20, "{shared} shared, {mixed} mixed");
+}
+
 /// A light without power is never chosen, under the paper's rules (power
 /// ratios all the way down) and the defaults: its pmf is exactly 0 wherever
 /// it sits in the tree, left or right of a lit sibling.

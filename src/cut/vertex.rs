@@ -277,4 +277,29 @@ mod tests {
             }
         }
     }
+
+    /// A vertex prints where it is, its cell and its cut (a renderer's
+    /// logs show which cell a shading point was guided by).
+    #[test]
+    fn a_vertex_prints_where_it_is() {
+        use crate::Emitter;
+        use crate::cut::{CutConfig, CutRules};
+        use crate::light_sampler::ShadingContext;
+        use crate::light_tree::{BuildHeuristic, LightTree};
+        let lights = [Emitter::point(Vec3::X, 1.0), Emitter::point(Vec3::Y, 2.0)];
+        let tree = LightTree::build(lights.as_slice(), BuildHeuristic::Sarh).unwrap();
+        let rules = CutRules::new(&tree, CutConfig::default()).unwrap();
+        let cut = rules.new_cut();
+        let p = Vec3::new(0.5, 1.5, -2.0);
+        let text = alloc::format!("{:?}", rules.vertex(&cut, &ShadingContext::at(p)));
+        for part in [
+            "LightVertex",
+            "position",
+            "0.5",
+            "cell: None",
+            "cut: GuidingCut",
+        ] {
+            assert!(text.contains(part), "{part} not in {text}");
+        }
+    }
 }
