@@ -63,6 +63,7 @@
 //! | a path's radiance records | `src/path_recorder.rs` |
 //! | the save format and its checks | `src/persist/`, `docs/format.md` |
 //! | light-tree build heuristics | `src/light_tree/build/heuristic.rs` (the binned split: `build/binned.rs`) |
+//! | refitting the light tree to lights that moved, and when to rebuild | `src/light_tree/build/refit.rs` |
 //! | the importance of a light cluster | `src/light_sampler/importance.rs` |
 //! | the same, from decoded nodes in `f32` (the GLT's importance rules) | `src/cut/importance_table.rs` |
 //! | the one-number descent | `src/math/descent.rs` |

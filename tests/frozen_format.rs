@@ -457,6 +457,43 @@ fn a_newer_version_is_refused_with_a_typed_error() {
     }
 }
 
+/// What learned state binds to: a file of version 4 on loads over the tree
+/// refitted to lights that moved (the same shape); a file of an earlier
+/// version only over the very tree it was saved with.
+#[test]
+fn from_version_4_state_loads_over_a_refitted_tree() {
+    let mut lights = two_rooms();
+    for l in &mut lights {
+        let d = Vec3::new(0.05, 0.1, -0.1);
+        l.bounds = guiding::Aabb::new(l.bounds.min + d, l.bounds.max + d);
+    }
+    let mut refitted = tree().clone();
+    refitted.refit(lights.as_slice()).unwrap();
+    for (n, dir) in versions() {
+        for name in [
+            "glt_default",
+            "glt_configured",
+            "field_default",
+            "field_configured",
+        ] {
+            let bytes = std::fs::read(dir.join(format!("{name}.bin"))).unwrap();
+            let (glt, field) = match name.starts_with("glt") {
+                true => (Glt::from_bytes(&bytes, &refitted).err(), None),
+                false => (None, GuidingField::from_bytes(&bytes, &refitted).err()),
+            };
+            let refused =
+                |e: &Option<LoadError>| matches!(e, Some(LoadError::LightTreeMismatch { .. }));
+            match n {
+                4.. => assert!(
+                    glt.is_none() && field.is_none(),
+                    "v{n} {name}: {glt:?} {field:?}"
+                ),
+                _ => assert!(refused(&glt) || refused(&field), "v{n} {name}"),
+            }
+        }
+    }
+}
+
 /// Control: the layout check sees a changed byte in the payload, and the
 /// answers check sees a changed answer.
 #[test]

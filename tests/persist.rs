@@ -163,20 +163,34 @@ fn learned_state_loads_only_against_its_light_tree() {
     let mut glt = Glt::new(&tree, scene(), GltConfig::default()).unwrap();
     train(&mut glt, &lights, 5, 2, 3000);
     let bytes = glt.to_bytes();
-    // Another build of the same lights, another order, one light changed.
+    // Another build of the same lights, another order, one light fewer.
     let other_build = LightTree::build(&lights, BuildHeuristic::Balanced).unwrap();
     let mut reordered = lights.clone();
     reordered.swap(0, 50);
     let reordered = LightTree::build(&reordered, BuildHeuristic::Sarh).unwrap();
-    let mut brighter = lights.clone();
-    brighter[3].power *= 2.0;
-    let brighter = LightTree::build(&brighter, BuildHeuristic::Sarh).unwrap();
-    for other in [&other_build, &reordered, &brighter] {
+    let fewer = LightTree::build(&lights[1..], BuildHeuristic::Sarh).unwrap();
+    for other in [&other_build, &reordered, &fewer] {
         assert!(matches!(
             Glt::from_bytes(&bytes, other),
             Err(LoadError::LightTreeMismatch { .. })
         ));
     }
+    // The tree refitted to lights that moved and changed power has the
+    // same shape: the state loads over it, and is the state carried over
+    // in memory.
+    let mut moved = lights.clone();
+    for (i, l) in moved.iter_mut().enumerate() {
+        let d = Vec3::new(0.1, -0.05 * (i % 3) as f32, 0.02);
+        l.bounds = guiding::Aabb::new(l.bounds.min + d, l.bounds.max + d);
+        l.power *= 1.0 + 0.01 * (i % 7) as f32;
+    }
+    let mut refitted = tree.clone();
+    refitted.refit(moved.as_slice()).unwrap();
+    let loaded = Glt::from_bytes(&bytes, &refitted).unwrap();
+    let mut carried = Glt::from_bytes(&bytes, &tree).unwrap();
+    carried.set_light_tree(&refitted).unwrap();
+    assert_same_answers(&loaded, &carried, 7);
+    assert_eq!(loaded.to_bytes(), bytes);
     // The tree itself can travel with the state.
     let tree_bytes = tree.to_bytes();
     let loaded = LightTree::from_bytes(&tree_bytes).unwrap();

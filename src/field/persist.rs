@@ -4,7 +4,7 @@
 use super::{FieldCell, GuidingField};
 use crate::cut::{CutConfig, CutRules, GuidingCut, OctantSplats};
 use crate::light_tree::LightHierarchy;
-use crate::light_tree::{fingerprint, read_fingerprint};
+use crate::light_tree::{fingerprint, read_fingerprint, shape_fingerprint};
 use crate::persist::{Kind, LoadError, Reader, Writer, tag, untag};
 use crate::sd_tree::{SdCell, SdState};
 use crate::spatial::BinaryTree;
@@ -12,12 +12,12 @@ use crate::spatial::FILTERS;
 use alloc::vec::Vec;
 
 impl<H: LightHierarchy> GuidingField<H> {
-    /// The field as bytes: a header, the light hierarchy's fingerprint, the
+    /// The field as bytes: a header, the light hierarchy's shape fingerprint, the
     /// SD-tree's configuration and state, the cuts' configuration, the
     /// light filter and every cell (quadtrees, fraction, cut, sums).
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut w = Writer::default();
-        w.u64(fingerprint(self.light_tree()));
+        w.u64(shape_fingerprint(self.light_tree()));
         self.sd.write(&mut w);
         self.guide.config().write(&mut w);
         w.u8(tag(&FILTERS, self.light_filter));
@@ -31,7 +31,8 @@ impl<H: LightHierarchy> GuidingField<H> {
     }
 
     /// The field saved by [`GuidingField::to_bytes`] over `lights`, which
-    /// must be the hierarchy it was trained with
+    /// must be the hierarchy it was trained with or a refit of it (as
+    /// [`Glt::from_bytes`](crate::Glt::from_bytes))
     /// ([`LoadError::LightTreeMismatch`] otherwise); checked, and then
     /// exactly like the one saved.
     pub fn from_bytes(bytes: &[u8], lights: H) -> Result<Self, LoadError> {

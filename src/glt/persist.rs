@@ -8,7 +8,7 @@ use super::guiding_light_tree::Glt;
 use crate::cut::{CutConfig, CutRules, GuidingCut, OctantSplats};
 use crate::dropped::DropCounters;
 use crate::light_tree::LightHierarchy;
-use crate::light_tree::{fingerprint, read_fingerprint};
+use crate::light_tree::{fingerprint, read_fingerprint, shape_fingerprint};
 use crate::persist::{Kind, LoadError, Reader, Writer, tag, untag};
 use crate::spatial::FILTERS;
 use alloc::vec::Vec;
@@ -41,13 +41,13 @@ impl GltConfig {
 
 impl<H: LightHierarchy> Glt<H> {
     /// The learned state as bytes: a header, the light hierarchy's
-    /// `fingerprint`, the configuration, the
+    /// `shape_fingerprint`, the configuration, the
     /// iteration, the drop counts and every cell (cut, sums, counts).
     /// Accumulating sums are included, so a saved GLT can be merged or go
     /// on learning.
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut w = Writer::default();
-        w.u64(fingerprint(self.light_tree()));
+        w.u64(shape_fingerprint(self.light_tree()));
         self.config.write(&mut w);
         w.u32(self.iteration);
         self.dropped.write(&mut w);
@@ -63,8 +63,10 @@ impl<H: LightHierarchy> Glt<H> {
     }
 
     /// The GLT saved by [`Glt::to_bytes`] over `tree`, which must be the
-    /// hierarchy it was trained with ([`LoadError::LightTreeMismatch`]
-    /// otherwise). Everything is checked; a GLT that loads samples, gives
+    /// hierarchy it was trained with or a refit of it
+    /// ([`LightTree::refit`](crate::LightTree::refit): the same shape;
+    /// files before format version 4: the very same tree), else
+    /// [`LoadError::LightTreeMismatch`]. Everything is checked; a GLT that loads samples, gives
     /// pmfs and learns exactly like the one saved.
     pub fn from_bytes(bytes: &[u8], tree: H) -> Result<Self, LoadError> {
         let mut r = Reader::open(bytes, Kind::Glt)?;

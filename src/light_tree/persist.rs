@@ -4,6 +4,7 @@
 use super::LightTree;
 use super::hierarchy::LightHierarchy;
 use super::node::{LEAF_BIT, LightNode, NO_PARENT};
+use super::shape::shape_fingerprint;
 use crate::math::Aabb;
 use crate::persist::{Kind, LoadError, Reader, Writer};
 use alloc::vec;
@@ -144,13 +145,19 @@ fn check_structure(nodes: &[LightNode], leaf_of: &[u32]) -> Result<usize, &'stat
     Ok(depth)
 }
 
-/// Reads a saved fingerprint and checks it against `tree`'s.
+/// Reads the saved binding of learned state to its light hierarchy and
+/// checks it against `tree`: since format version 4 the hierarchy's shape
+/// ([`shape_fingerprint`]: a tree and its refits match), before it the
+/// whole tree ([`fingerprint`]: bounds and powers too).
 pub(crate) fn read_fingerprint<H: LightHierarchy + ?Sized>(
     r: &mut crate::persist::Reader<'_>,
     tree: &H,
 ) -> Result<(), crate::persist::LoadError> {
     let saved = r.u64("light tree fingerprint")?;
-    let given = fingerprint(tree);
+    let given = match r.version() {
+        4.. => shape_fingerprint(tree),
+        _ => fingerprint(tree),
+    };
     if saved == given {
         Ok(())
     } else {

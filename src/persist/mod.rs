@@ -25,13 +25,21 @@
 //! untrusted sources into a structure whose refinement is bounded
 //! (`max_bytes`), or do not refine them.
 //!
-//! Learned state refers to the light hierarchy it was trained with: the
-//! file holds the hierarchy's [`fingerprint`](crate::light_tree::fingerprint), and loading against another
-//! hierarchy (other lights, another order, another build) is
-//! [`LoadError::LightTreeMismatch`]. Between runs a renderer may change the
-//! camera, the resolution and the sample counts; it may not change the
-//! lights or how the light tree is built (save the tree with the state, or
-//! build it the same way from the same lights).
+//! Learned state refers to the light hierarchy it was trained with by node
+//! index: the file holds the hierarchy's
+//! [`shape_fingerprint`](crate::light_tree::shape_fingerprint) (its nodes'
+//! links and each leaf's emitter), and loading against a hierarchy of
+//! another shape (other lights, another order, another build) is
+//! [`LoadError::LightTreeMismatch`]. A refit of the tree
+//! ([`LightTree::refit`](crate::LightTree::refit): the lights moved or
+//! changed power) has the same shape, so state saved at one frame of an
+//! animation loads over the tree refitted to any other. Between runs a
+//! renderer may change the camera, the resolution and the sample counts,
+//! and move its lights through refits; it may not add, remove or reorder
+//! lights or rebuild the tree (save the tree with the state, or build it
+//! the same way from the same lights). Files before format version 4 hold
+//! the whole tree's [`fingerprint`](crate::light_tree::fingerprint) and
+//! load only over the very tree they were saved with.
 
 mod bytes;
 mod error;
