@@ -1037,7 +1037,7 @@ fn refit_works_at_any_depth_and_scale() {
 }
 
 #[test]
-fn refit_cost_tells_a_small_move_from_a_scramble() {
+fn refit_drift_tells_a_small_move_from_a_scramble() {
     let scene = mixed_scene(3000, 74);
     let mut r = Rand::new(75);
     for h in HEURISTICS {
@@ -1060,6 +1060,16 @@ fn refit_cost_tells_a_small_move_from_a_scramble() {
             .collect();
         let big = tree.refit(scrambled.as_slice()).unwrap();
         assert!(big > LightTree::REBUILD_RATIO, "{h:?}: {big}");
+        // Power alone changes no box: no drift at all.
+        let mut tree = built.clone();
+        let flicker: Vec<Emitter> = scene
+            .iter()
+            .map(|e| Emitter {
+                power: e.power * r.range(0.5, 2.0),
+                ..*e
+            })
+            .collect();
+        assert_eq!(tree.refit(flicker.as_slice()), Ok(1.0), "{h:?}");
     }
 }
 

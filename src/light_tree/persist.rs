@@ -77,13 +77,13 @@ impl LightTree {
         let depth = check_structure(&nodes, &leaf_of).map_err(|field| {
             Reader::invalid(field, if field.contains("leaf") { leaf_at } else { at })
         })?;
-        let built_cost = super::build::cost(&nodes, &scene);
+        let built_spread = super::build::spread(&nodes, &scene);
         Ok(Self {
             nodes,
             leaf_of,
             scene,
             depth,
-            built_cost,
+            built_spread,
         })
     }
 }

@@ -1,5 +1,5 @@
 use super::BuildError;
-use super::build::{BuildHeuristic, build, cost, refit};
+use super::build::{BuildHeuristic, build, refit, spread};
 use super::hierarchy::{LightHierarchy, NodeBounds};
 use super::node::{LEAF_BIT, LightNode, NO_PARENT};
 use crate::emitter::Emitters;
@@ -20,8 +20,8 @@ pub struct LightTree {
     pub(super) leaf_of: Vec<u32>,
     pub(super) scene: Aabb,
     pub(super) depth: usize,
-    /// The tree's cost (`build/refit.rs`) when it was built or loaded.
-    pub(super) built_cost: f32,
+    /// The tree's spread (`build/refit.rs`) when it was built or loaded.
+    pub(super) built_spread: f32,
 }
 
 impl LightTree {
@@ -38,9 +38,11 @@ impl LightTree {
         build(emitters, heuristic)
     }
 
-    /// A refit whose cost ratio ([`LightTree::refit`]) passes this is worth
-    /// a rebuild: past it, sampling from the refitted tree measurably
-    /// loses to sampling from a new one (docs/experiments/refit.md).
+    /// A refit whose drift ([`LightTree::refit`]) passes this is worth a
+    /// rebuild when the learned state can be given up: at 1.5 the
+    /// refitted tree's importance sampling had 1.5x the variance of a
+    /// rebuilt tree's, about what a guide's learned state is worth in an
+    /// animation (docs/experiments/refit.md).
     pub const REBUILD_RATIO: f32 = 1.5;
 
     /// Updates the tree to `emitters` after they moved, turned or changed
@@ -51,9 +53,11 @@ impl LightTree {
     /// learned: hand them the refitted tree
     /// ([`Glt::set_light_tree`](crate::Glt::set_light_tree)).
     ///
-    /// Returns how much the tree drifted: its cost (power-weighted spread
-    /// of its clusters in space and direction) over its cost when built, 1
-    /// when nothing moved. Past [`LightTree::REBUILD_RATIO`], build a new
+    /// Returns how far the tree drifted: the spread of its clusters (the
+    /// sum of their boxes' squared diagonals, over the root's) over the
+    /// spread when it was built, 1 when nothing moved; it grows as lights
+    /// leave the ones they were clustered with, and stays 1 for changes of
+    /// power alone. Past [`LightTree::REBUILD_RATIO`], build a new
     /// tree (and start learning again). Errors as [`LightTree::build`]
     /// does, and [`BuildError::EmitterCount`] for another number of
     /// emitters; on an error the tree is unchanged.
@@ -61,8 +65,8 @@ impl LightTree {
         let (nodes, scene) = refit(self, emitters)?;
         self.nodes = nodes;
         self.scene = scene;
-        let now = cost(&self.nodes, &self.scene);
-        Ok(match (now, self.built_cost) {
+        let now = spread(&self.nodes, &self.scene);
+        Ok(match (now, self.built_spread) {
             (now, built) if built > 0.0 => now / built,
             (now, _) if now > 0.0 => f32::INFINITY,
             _ => 1.0,

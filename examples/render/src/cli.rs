@@ -193,6 +193,15 @@ pub struct Args {
     /// (one sample per pixel per pass, PPG's iterations).
     #[arg(long, value_name = "RULE", value_parser = crate::tiles::Refinement::parse)]
     pub tiles: Option<crate::tiles::Refinement>,
+    /// Render an animation of this many frames instead: every light
+    /// circling its place, the camera moving sideways. Each trained method
+    /// renders every frame three ways at the same budget, from scratch,
+    /// carrying its guide over with the first frame's light tree, and
+    /// carrying it over with the light tree refitted to the frame; each
+    /// frame against its own reference (`--reference-seconds`). Writes
+    /// `<out>/<scene>/frames.md`.
+    #[arg(long, default_value_t = 1)]
+    pub frames: u32,
     /// Move the camera by `x,y,z` (the next frame of a camera move).
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub camera_shift: Option<Vec<f32>>,

@@ -12,14 +12,17 @@
 //! `integrator` (the path tracer and its training records), `methods`
 //! (which crate objects a method uses), `run` (passes, training schedule,
 //! combination), `film` (EXR/PNG), `reference` (cache), `metrics`,
-//! `report` (JSON, table), `sheet` (comparison sheet).
+//! `report` (JSON, table), `sheet` (comparison sheet), `animation` and
+//! `frames` (an animated scene and its frames rendered three ways).
 #![allow(missing_docs)]
 
+pub mod animation;
 pub mod bvh;
 pub mod camera;
 pub mod cli;
 pub mod crossing;
 pub mod film;
+pub mod frames;
 pub mod geometry;
 pub mod integrator;
 pub mod json;

@@ -16,8 +16,8 @@
 //! `report` (JSON, table), `sheet` (comparison sheet).
 
 use guiding_render::{
-    cli, crossing, film, methods, metrics, plot, raster, reference, report, rng, run, scenes,
-    sheet, tiles,
+    cli, crossing, film, frames, methods, metrics, plot, raster, reference, report, rng, run,
+    scenes, sheet, tiles,
 };
 
 use clap::Parser;
@@ -142,8 +142,24 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
         guide_files: run::GuideFiles {
             load: args.load_guide.clone(),
             save: args.save_guide.clone(),
+            restart: false,
         },
     };
+    if args.frames > 1 {
+        for name in &scene_names {
+            let table = frames::run(
+                args,
+                name,
+                size,
+                &methods,
+                &settings,
+                reference_method,
+                reference_budget,
+            )?;
+            println!("{table}");
+        }
+        return Ok(());
+    }
     let mut all = Vec::new();
     for name in &scene_names {
         let (records, trust) = run_scene(

@@ -56,6 +56,11 @@ pub struct GuideFiles {
     pub load: Option<std::path::PathBuf>,
     /// Save the learned guide here.
     pub save: Option<std::path::PathBuf>,
+    /// Start the doubling schedule over from a loaded guide (the next
+    /// frame of an animation: what was learned is a head start, the frame
+    /// still renders its whole budget) instead of going on from the
+    /// iteration it reached.
+    pub restart: bool,
 }
 
 impl GuideFiles {
@@ -302,6 +307,9 @@ pub fn render_observed<'a>(
                 method.name(),
                 scene.name
             );
+        }
+        if settings.guide_files.restart {
+            k = 0;
         }
     }
     let bar = progress_bar(settings, method);

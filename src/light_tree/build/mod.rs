@@ -20,7 +20,7 @@ use cone_bound::ConeBound;
 pub use heuristic::BuildHeuristic;
 use heuristic::OrientationMemo;
 use items::{Item, validate};
-pub(super) use refit::{cost, refit};
+pub(super) use refit::{refit, spread};
 
 /// Exact (unquantised) data of a node while building.
 #[derive(Clone, Copy)]
@@ -74,7 +74,7 @@ fn build_with<E: Emitters + ?Sized>(
             leaf_of: Vec::new(),
             scene: Aabb::EMPTY,
             depth: 0,
-            built_cost: 0.0,
+            built_spread: 0.0,
         });
     }
     // Past this depth, splits become medians: keeps the build O(n log n) and
@@ -143,13 +143,13 @@ fn build_with<E: Emitters + ?Sized>(
     drop(items);
     drop(scratch);
     let (nodes, scene) = aggregate_and_encode(&mut agg)?;
-    let built_cost = cost(&nodes, &scene);
+    let built_spread = spread(&nodes, &scene);
     Ok(LightTree {
         nodes,
         leaf_of,
         scene,
         depth,
-        built_cost,
+        built_spread,
     })
 }
 
