@@ -192,8 +192,8 @@ pub mod build {
     /// Builds a light tree of the emitters `data` describes with two
     /// heuristics and checks each tree that builds; returns how many did.
     pub fn build_light_tree(data: &[u8]) -> usize {
-        // 40 bytes per emitter: bounds (6 f32), power, area, cone axis x and a
-        // flag byte... read loosely.
+        // 40 bytes per emitter: bounds (6 f32), power, area, cone axis x, a
+        // flag byte, the cone's two cosines and a weight... read loosely.
         let emitters: Vec<Emitter> = data
             .chunks_exact(40)
             .take(64)
@@ -213,6 +213,11 @@ pub mod build {
                     }),
                     two_sided: c[36] & 2 == 2,
                     delta: c[36] & 4 == 4,
+                    // Flag bit 3: a weight from the last byte (0 to ~4).
+                    weight: match c[36] & 8 {
+                        8 => f32::from(c[39]) / 64.0,
+                        _ => 1.0,
+                    },
                 }
             })
             .collect();
@@ -227,7 +232,7 @@ pub mod build {
                 let total: f64 = (0..emitters.len() as u32)
                     .map(|e| s.pmf_exact(&ctx, LightId::Emitter(e)))
                     .sum();
-                if emitters.iter().any(|e| e.power > 0.0) {
+                if emitters.iter().any(|e| e.power * e.weight > 0.0) {
                     assert!((total - 1.0).abs() < 1e-4, "{total}");
                 } else {
                     assert!(s.is_empty() && total == 0.0, "{total}");

@@ -41,6 +41,21 @@ pub trait Emitters {
     fn is_delta(&self, _i: usize) -> bool {
         false
     }
+
+    /// The renderer's multiplier on how often emitter `i` is chosen (a light
+    /// the artist knows matters, or one to sample less): every sampler
+    /// chooses by power times weight where it chooses by power (the power
+    /// sampler, the light tree's samplers, the GLT's prior and its choice
+    /// below the cut), and in proportion to the weight where it ignores
+    /// power (the uniform sampler). Estimates stay unbiased: the pmfs say
+    /// exactly what was done, and the renderer divides by them. What a GLT
+    /// learns from records is not weighted (records say what arrives). 1 by
+    /// default; must be finite and non-negative. A weight of 0 means the
+    /// light is never chosen: only BSDF sampling can then find it, so give
+    /// it only to lights BSDF sampling can hit, or that may be left out.
+    fn weight(&self, _i: usize) -> f32 {
+        1.0
+    }
 }
 
 /// A plain description of one emitter, for renderers that would rather hand
@@ -59,6 +74,9 @@ pub struct Emitter {
     pub two_sided: bool,
     /// Point or spot light.
     pub delta: bool,
+    /// The multiplier on how often it is chosen ([`Emitters::weight`]); 1
+    /// from every constructor.
+    pub weight: f32,
 }
 
 impl Emitter {
@@ -71,6 +89,7 @@ impl Emitter {
             cone: None,
             two_sided: false,
             delta: true,
+            weight: 1.0,
         }
     }
 
@@ -87,6 +106,7 @@ impl Emitter {
             cone: Some(LightCone::lambertian(normal)),
             two_sided: false,
             delta: false,
+            weight: 1.0,
         }
     }
 
@@ -183,6 +203,7 @@ impl Emitter {
             cone: Some(LightCone::new(w, angle(cos_theta_o), angle(cos_theta_e))),
             two_sided,
             delta,
+            weight: 1.0,
         }
     }
 
@@ -195,7 +216,14 @@ impl Emitter {
             cone: None,
             two_sided: false,
             delta: false,
+            weight: 1.0,
         }
+    }
+
+    /// This emitter chosen `weight` times as often relative to the others
+    /// ([`Emitters::weight`]).
+    pub fn with_weight(self, weight: f32) -> Self {
+        Self { weight, ..self }
     }
 }
 
@@ -223,6 +251,9 @@ macro_rules! emitters_for_list {
             }
             fn is_delta(&self, i: usize) -> bool {
                 self[i].delta
+            }
+            fn weight(&self, i: usize) -> f32 {
+                self[i].weight
             }
         }
     )*};

@@ -34,7 +34,7 @@ use crate::math::Aabb;
 /// ```
 #[derive(Debug)]
 pub enum Strategy {
-    /// Every emitter equally.
+    /// Every emitter equally (in proportion to their weights, if any).
     Uniform(WithUnbounded<UniformSampler>),
     /// In proportion to power.
     Power(WithUnbounded<PowerSampler>),
@@ -63,7 +63,7 @@ impl Strategy {
         let tree = || LightTree::build(emitters, BuildHeuristic::default()).map_err(Error::Build);
         let u = unbounded;
         Ok(match name {
-            "uniform" => Self::Uniform(WithUnbounded::new(UniformSampler::new(emitters.len()), u)?),
+            "uniform" => Self::Uniform(WithUnbounded::new(UniformSampler::weighted(emitters), u)?),
             "power" => Self::Power(WithUnbounded::new(PowerSampler::new(emitters), u)?),
             "importance" => {
                 Self::Importance(WithUnbounded::new(ImportanceTreeSampler::new(tree()?), u)?)

@@ -235,7 +235,12 @@ fn check_tree(tree: &LightTree, emitters: &[Emitter]) -> Vec<usize> {
         match tree.children(node) {
             None => {
                 let em = tree.emitter(node).unwrap() as usize;
-                assert_eq!(e, emitters[em].power, "leaf power is the power");
+                let emitter = &emitters[em];
+                assert_eq!(
+                    e,
+                    emitter.power * emitter.weight,
+                    "leaf power is the power times the weight"
+                );
             }
             Some([l, r]) => {
                 let sum = tree.power(l) as f64 + tree.power(r) as f64;
@@ -247,7 +252,7 @@ fn check_tree(tree: &LightTree, emitters: &[Emitter]) -> Vec<usize> {
             }
         }
     }
-    let total: f64 = emitters.iter().map(|e| e.power as f64).sum();
+    let total: f64 = emitters.iter().map(|e| (e.power * e.weight) as f64).sum();
     let root_e = tree.total_power() as f64;
     assert!(
         (root_e - total).abs() <= total * 1e-6,
@@ -678,6 +683,20 @@ fn bad_input_is_a_typed_error_naming_the_emitter() {
             },
         ),
         (
+            with(3, &|e| e.weight = -1.0),
+            BuildError::InvalidWeight {
+                emitter: 3,
+                weight: -1.0,
+            },
+        ),
+        (
+            with(3, &|e| e.weight = inf),
+            BuildError::InvalidWeight {
+                emitter: 3,
+                weight: inf,
+            },
+        ),
+        (
             with(7, &|e| e.area = -0.5),
             BuildError::InvalidArea {
                 emitter: 7,
@@ -795,6 +814,8 @@ fn valid(e: &Emitter) -> bool {
         && e.power.is_finite()
         && e.area >= 0.0
         && e.area.is_finite()
+        && e.weight >= 0.0
+        && e.weight.is_finite()
         && e.cone.is_none_or(|c| {
             c.axis.is_finite() && c.cos_theta_o.is_finite() && c.cos_theta_e.is_finite()
         })
@@ -837,6 +858,7 @@ fn random_bit_patterns_never_panic() {
                     cone,
                     two_sided: r.f() < 0.5,
                     delta: false,
+                    weight: if r.f() < 0.8 { 1.0 } else { any(&mut r) },
                 }
             })
             .collect();
@@ -850,7 +872,7 @@ fn random_bit_patterns_never_panic() {
             }
             Err(BuildError::PowerOverflow) => {
                 assert_eq!(first_bad, None);
-                let total: f64 = scene.iter().map(|e| e.power as f64).sum();
+                let total: f64 = scene.iter().map(|e| (e.power * e.weight) as f64).sum();
                 assert!(!(total as f32).is_finite());
             }
             Err(err) => {
@@ -858,6 +880,7 @@ fn random_bit_patterns_never_panic() {
                     BuildError::InvalidBounds { emitter }
                     | BuildError::InvalidPower { emitter, .. }
                     | BuildError::InvalidArea { emitter, .. }
+                    | BuildError::InvalidWeight { emitter, .. }
                     | BuildError::InvalidCone { emitter } => emitter,
                     other => panic!("unexpected {other:?}"),
                 };

@@ -40,9 +40,11 @@ pub struct PowerSampler {
 }
 
 impl PowerSampler {
-    /// A sampler over the powers of `emitters`.
+    /// A sampler over the powers of `emitters`, each times its weight
+    /// ([`Emitters::weight`]; a product that is not a positive finite
+    /// number counts as zero).
     pub fn new<E: Emitters + ?Sized>(emitters: &E) -> Self {
-        Self::from_powers((0..emitters.len()).map(|i| emitters.power(i)))
+        Self::from_powers((0..emitters.len()).map(|i| emitters.power(i) * emitters.weight(i)))
     }
 
     /// A sampler over emitters `0..n` with the given powers (at most

@@ -1,24 +1,28 @@
 //! Uniform light selection: the baseline every other sampler is measured
 //! against.
 
-use super::ShadingContext;
 use super::{LightId, LightSample, LightSampler, pmf_to_f32};
+use super::{PowerSampler, ShadingContext};
+use crate::emitter::Emitters;
 use crate::math::Descent;
 
 /// The most emitters a [`LightId::Emitter`] can name.
 const MAX_EMITTERS: u64 = u32::MAX as u64 + 1;
 
 /// Chooses every emitter with the same probability `1 / count`, whatever its
-/// power or position.
+/// power or position; over emitters with weights
+/// ([`UniformSampler::weighted`]), in proportion to their weights.
 ///
 /// `u` maps to emitter `floor(u * count)` (an inverse CDF, so stratified `u`
 /// stays stratified). Counts beyond 2^32 are capped at 2^32, the number of
 /// ids a [`LightId::Emitter`] can hold. With `count == 0` nothing is
 /// sampled.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct UniformSampler {
     count: u64,
     pmf: f32,
+    /// The weights' alias table, when some weight is not 1.
+    weighted: Option<PowerSampler>,
 }
 
 impl UniformSampler {
@@ -30,7 +34,29 @@ impl UniformSampler {
         } else {
             pmf_to_f32(1.0 / count as f64)
         };
-        Self { count, pmf }
+        Self {
+            count,
+            pmf,
+            weighted: None,
+        }
+    }
+
+    /// A sampler over `emitters` that chooses each in proportion to its
+    /// weight ([`Emitters::weight`]; one that is not a positive finite
+    /// number counts as zero): exactly [`UniformSampler::new`] when every
+    /// weight is 1, else an alias table of the weights (16 bytes per
+    /// emitter).
+    pub fn weighted<E: Emitters + ?Sized>(emitters: &E) -> Self {
+        let n = emitters.len();
+        if (0..n).all(|i| emitters.weight(i) == 1.0) {
+            return Self::new(n);
+        }
+        Self {
+            weighted: Some(PowerSampler::from_powers(
+                (0..n).map(|i| emitters.weight(i)),
+            )),
+            ..Self::new(n)
+        }
     }
 
     /// Number of emitters it chooses from.
@@ -42,6 +68,9 @@ impl UniformSampler {
 impl LightSampler for UniformSampler {
     #[inline]
     fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
+        if let Some(w) = &self.weighted {
+            return w.sample(ctx, u);
+        }
         if self.is_empty() || !ctx.is_finite() {
             return None;
         }
@@ -56,6 +85,9 @@ impl LightSampler for UniformSampler {
 
     #[inline]
     fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        if let Some(w) = &self.weighted {
+            return w.pmf(ctx, light);
+        }
         if !ctx.is_finite() {
             return 0.0;
         }
@@ -67,7 +99,10 @@ impl LightSampler for UniformSampler {
 
     #[inline]
     fn is_empty(&self) -> bool {
-        self.count == 0
+        match &self.weighted {
+            Some(w) => w.is_empty(),
+            None => self.count == 0,
+        }
     }
 }
 

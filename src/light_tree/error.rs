@@ -17,6 +17,14 @@ pub enum BuildError {
         /// The power it reported.
         power: f32,
     },
+    /// An emitter's weight ([`Emitters::weight`](crate::Emitters::weight))
+    /// is NaN, infinite or negative.
+    InvalidWeight {
+        /// The emitter's index.
+        emitter: usize,
+        /// The weight it reported.
+        weight: f32,
+    },
     /// An emitter's area is NaN, infinite or negative.
     InvalidArea {
         /// The emitter's index.
@@ -34,7 +42,7 @@ pub enum BuildError {
         /// How many were given.
         count: usize,
     },
-    /// The total power does not fit in an `f32`.
+    /// The total power (times the weights) does not fit in an `f32`.
     PowerOverflow,
     /// [`LightTree::refit`](super::LightTree::refit) was given another
     /// number of emitters than the tree holds.
@@ -54,6 +62,9 @@ impl fmt::Display for BuildError {
             }
             Self::InvalidPower { emitter, power } => {
                 write!(f, "emitter {emitter} has invalid power {power}")
+            }
+            Self::InvalidWeight { emitter, weight } => {
+                write!(f, "emitter {emitter} has invalid weight {weight}")
             }
             Self::InvalidArea { emitter, area } => {
                 write!(f, "emitter {emitter} has invalid area {area}")

@@ -38,6 +38,13 @@ pub(super) fn validate<E: Emitters + ?Sized>(emitters: &E) -> Result<Vec<Item>, 
         if !(power >= 0.0 && power.is_finite()) {
             return Err(BuildError::InvalidPower { emitter: i, power });
         }
+        let weight = emitters.weight(i);
+        if !(weight >= 0.0 && weight.is_finite()) {
+            return Err(BuildError::InvalidWeight { emitter: i, weight });
+        }
+        // The tree chooses by power times weight (a product past f32 makes
+        // the total overflow: `PowerOverflow` once every emitter is checked).
+        let power = power * weight;
         let area = emitters.area(i);
         if !(area >= 0.0 && area.is_finite()) {
             return Err(BuildError::InvalidArea { emitter: i, area });

@@ -67,10 +67,10 @@ pub(in crate::light_tree) fn refit<E: Emitters + ?Sized>(
 ///
 /// Measured (`cargo run --release --example refit_drift`,
 /// docs/experiments/refit.md): the variance of importance sampling over a
-/// refitted tree grows about as this ratio does (at 1.5, 1.5x the rebuilt
-/// tree's), whereas a cost weighted by power (SAOH's terms) stayed within
-/// 1.1 while the variance doubled; changes of power alone cost nothing
-/// (the refitted tree sampled no worse than a rebuilt one).
+/// refitted tree grows with this ratio (a drift of 1.2 to 1.5: 1.1 to 1.7
+/// times a rebuilt tree's), whereas a cost weighted by power (SAOH's terms)
+/// stayed within 1.1 while the variance doubled; changes of power alone
+/// cost nothing (the refitted tree sampled no worse than a rebuilt one).
 pub(in crate::light_tree) fn spread(nodes: &[LightNode], scene: &Aabb) -> f32 {
     let squared_diagonal = |n: &LightNode| {
         let d = n.decode(scene).bounds.diagonal();
