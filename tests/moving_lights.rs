@@ -261,3 +261,54 @@ fn a_tree_of_another_shape_is_refused_and_nothing_changes() {
     assert!(borrowed.set_light_tree(&owned).is_ok());
     assert_eq!(borrowed.light_tree().node_count(), before.node_count());
 }
+
+/// A guide carried into a new frame re-learns from the new frame's records
+/// at once: after `restart` (which `set_light_tree` does) every cell with
+/// records takes part in the next refinement; without it, a cell waits for
+/// 3/2 of what it refined on last.
+#[test]
+fn a_restarted_glt_refines_every_cell_on_the_next_records() {
+    let (first, second) = frames(0.25, 1.1, false);
+    let tree = LightTree::build(first.as_slice(), BuildHeuristic::Sarh).unwrap();
+    let mut glt = Glt::new(tree.clone(), bounds(), glt_config()).unwrap();
+    // A long last iteration: many records per cell.
+    let mut records = records_of(&first);
+    records[3] = records[3].repeat(8);
+    train(&mut glt, &records, |g| {
+        g.refine();
+    });
+    let generations = |g: &Glt<LightTree>| -> Vec<u32> {
+        g.spatial()
+            .data_slice()
+            .iter()
+            .map(|c| c.generation())
+            .collect()
+    };
+    let few = &records_of(&second)[0][..3000];
+    let refined = |mut g: Glt<LightTree>| {
+        let before = generations(&g);
+        train(&mut g, &[few.to_vec()], |g| {
+            g.refine();
+        });
+        let after = generations(&g);
+        let took_part = before.iter().zip(&after).filter(|(b, a)| a > b).count();
+        (took_part, after.len())
+    };
+    let (waiting, cells) = refined(glt.clone());
+    assert_eq!(
+        waiting, 0,
+        "without a restart no cell has 3/2 of its last count"
+    );
+    let mut restarted = glt.clone();
+    restarted.restart();
+    let (taking_part, _) = refined(restarted);
+    assert!(
+        taking_part * 10 >= cells * 9,
+        "{taking_part} of {cells} cells refined"
+    );
+    let mut refitted = tree;
+    refitted.refit(second.as_slice()).unwrap();
+    glt.set_light_tree(refitted).unwrap();
+    let (after_refit, _) = refined(glt);
+    assert_eq!(after_refit, taking_part);
+}

@@ -93,10 +93,30 @@ impl<H: LightHierarchy> Glt<H> {
     /// glt.set_light_tree(tree)?;
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
+    ///
+    /// The lights have changed, so what the cells counted before describes
+    /// the old ones: every cell takes part in the next refinement
+    /// ([`Glt::restart`]).
     pub fn set_light_tree(&mut self, tree: H) -> Result<H, Error> {
-        self.guide
+        let old = self
+            .guide
             .set_light_tree(tree)
-            .map_err(|_| Error::LightTreeShape)
+            .map_err(|_| Error::LightTreeShape)?;
+        self.restart();
+        Ok(old)
+    }
+
+    /// Starts a new schedule from what was learned (the next frame of an
+    /// animation, a guide loaded to render another image): every cell
+    /// takes part in the next refinement with whatever it has collected by
+    /// then, as before its first, instead of waiting for 3/2 of the splats
+    /// it refined on last (which, after a long last iteration, a short
+    /// frame may never collect). The cuts, their sums, the spatial tree and
+    /// each cell's split clock are kept.
+    pub fn restart(&mut self) {
+        for cell in self.spatial.data_slice_mut() {
+            cell.used = 0;
+        }
     }
 
     /// The guiding tree every cell's cut is used through.

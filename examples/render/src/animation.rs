@@ -1,6 +1,7 @@
-//! An animated scene (`render --frames N`): frame `f` of a scene has every
-//! light moved along its own small circle and the camera moved along a
-//! line, the geometry otherwise as built.
+//! An animated scene (`render --frames N`): frame `f` of a scene has its
+//! lights moved along small circles, the lights of one neighbourhood
+//! together (as the emitters of one lamp or one car move together), and
+//! the camera moved along a line, the geometry otherwise as built.
 
 use crate::bvh::Bvh;
 use crate::geometry::{NO_EMITTER, Primitive, Shape};
@@ -13,17 +14,28 @@ use guiding::{Emitter, LightTree};
 
 /// Each light circles its place in the horizontal plane with a radius of
 /// this share of the scene's diagonal, ...
-const LIGHT_RADIUS: f32 = 0.01;
-/// ... advancing this many radians per frame (each light from its own
-/// phase), so it moves about 0.5% of the diagonal from frame to frame.
+const LIGHT_RADIUS: f32 = 0.004;
+/// ... advancing this many radians per frame, so it moves about 0.2% of
+/// the diagonal from frame to frame; ...
 const LIGHT_STEP: f32 = 0.5;
+/// ... from the phase of its neighbourhood: the cell of a grid of this
+/// share of the diagonal its centre lies in, so the triangles of one lamp
+/// move as one.
+const LIGHT_GROUP: f32 = 0.02;
 /// The camera moves this share of the diagonal per frame, sideways.
 const CAMERA_STEP: f32 = 0.002;
 
-/// Where light `i` is at frame `f`, relative to where it was built.
-fn light_offset(i: u32, f: u32, radius: f32) -> Vec3 {
-    let phase = (crate::rng::mix64(u64::from(i) ^ 0x9e37_79b9) >> 40) as f32 / (1u64 << 24) as f32
-        * core::f32::consts::TAU;
+/// Where a light whose centre was built at `c` is at frame `f`, relative
+/// to there, in a scene whose diagonal is `diagonal`.
+fn light_offset(c: Vec3, f: u32, diagonal: f32) -> Vec3 {
+    let cell = (c / (LIGHT_GROUP * diagonal)).floor().as_ivec3();
+    let key = [cell.x, cell.y, cell.z]
+        .iter()
+        .fold(0x9e37_79b9u64, |h, &x| {
+            crate::rng::mix64(h ^ x as u32 as u64)
+        });
+    let phase = (key >> 40) as f32 / (1u64 << 24) as f32 * core::f32::consts::TAU;
+    let radius = LIGHT_RADIUS * diagonal;
     let at = |t: f32| Vec3::new(t.cos(), 0.0, t.sin()) * radius;
     at(phase + LIGHT_STEP * f as f32) - at(phase)
 }
@@ -59,9 +71,11 @@ fn moved_primitive(p: &Primitive, d: Vec3) -> Primitive {
 /// (a renderer carrying its guides over replaces the light tree with a
 /// refit of the previous frame's).
 pub fn frame(base: &Scene, f: u32) -> Scene {
-    let radius = LIGHT_RADIUS * base.bounds.diagonal().length();
-    let offsets: Vec<Vec3> = (0..base.lights.len() as u32)
-        .map(|i| light_offset(i, f, radius))
+    let diagonal = base.bounds.diagonal().length();
+    let offsets: Vec<Vec3> = base
+        .emitters
+        .iter()
+        .map(|e| light_offset(e.bounds.min * 0.5 + e.bounds.max * 0.5, f, diagonal))
         .collect();
     let lights: Vec<Light> = base
         .lights

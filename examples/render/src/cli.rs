@@ -193,8 +193,9 @@ pub struct Args {
     /// (one sample per pixel per pass, PPG's iterations).
     #[arg(long, value_name = "RULE", value_parser = crate::tiles::Refinement::parse)]
     pub tiles: Option<crate::tiles::Refinement>,
-    /// Render an animation of this many frames instead: every light
-    /// circling its place, the camera moving sideways. Each trained method
+    /// Render an animation of this many frames instead: the lights circling
+    /// their places (neighbouring lights together, about 0.2% of the
+    /// scene's diagonal per frame), the camera moving sideways. Each trained method
     /// renders every frame three ways at the same budget, from scratch,
     /// carrying its guide over with the first frame's light tree, and
     /// carrying it over with the light tree refitted to the frame; each

@@ -310,6 +310,9 @@ pub fn render_observed<'a>(
         }
         if settings.guide_files.restart {
             k = 0;
+            if let Some(g) = &mut glt {
+                g.restart();
+            }
         }
     }
     let bar = progress_bar(settings, method);
