@@ -1573,23 +1573,17 @@ fn the_anchor_ignores_non_finite_positions() {
     assert_eq!(cut.anchor(), Some(at));
 }
 
-/// With the box filter a splat is shared among the cells its box overlaps,
-/// each taking a fraction of its weight; the anchor of each is still the
-/// position the splats came from (the position weighted by its share, over
-/// the shares), whatever the shares.
-#[test]
-fn shared_splats_anchor_where_they_came_from() {
+/// A GLT over `tree` (30 lights) whose light records use the box filter,
+/// trained for three iterations of uniform records into several cells.
+fn box_filter_glt<'a>(tree: &'a LightTree, rng: &mut Rand) -> guiding::glt::Glt<&'a LightTree> {
     use guiding::glt::{Glt, GltConfig};
     use guiding::spatial::SpatialFilter;
-    let mut rng = Rand::new(12);
-    let lights = lights_in_box(&mut rng, 30, 8.0);
-    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
     let config = GltConfig {
         light_filter: SpatialFilter::Box,
         spatial_threshold: 200.0,
         ..GltConfig::default()
     };
-    let mut glt = Glt::new(&tree, common::scene(), config).unwrap();
+    let mut glt = Glt::new(tree, common::scene(), config).unwrap();
     for _ in 0..3 {
         for _ in 0..3000 {
             let p = rng.point(9.0);
@@ -1597,6 +1591,18 @@ fn shared_splats_anchor_where_they_came_from() {
         }
         glt.refine();
     }
+    glt
+}
+
+/// With the box filter a splat is shared among the cells its box overlaps,
+/// each taking a fraction of its weight; the anchor of each is still the
+/// position the splats came from (the position weighted by its share, over
+/// the shares), whatever the shares.
+#[test]
+fn shared_splats_anchor_where_they_came_from() {
+    let mut rng = Rand::new(12);
+    let tree = LightTree::build(&lights_in_box(&mut rng, 30, 8.0), BuildHeuristic::Sarh).unwrap();
+    let glt = box_filter_glt(&tree, &mut rng);
     let p = Vec3::new(0.013, -0.021, 0.017);
     for _ in 0..10 {
         glt.record_light_at(p, LightId::Emitter(4), 1.0);
@@ -1624,24 +1630,10 @@ fn shared_splats_anchor_where_they_came_from() {
 #[test]
 fn box_filter_shares_a_records_value_by_volume() {
     use guiding::RecordOutcome;
-    use guiding::glt::{Glt, GltConfig};
-    use guiding::spatial::SpatialFilter;
+    use guiding::glt::Glt;
     let mut rng = Rand::new(13);
-    let lights = lights_in_box(&mut rng, 30, 8.0);
-    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
-    let config = GltConfig {
-        light_filter: SpatialFilter::Box,
-        spatial_threshold: 200.0,
-        ..GltConfig::default()
-    };
-    let mut glt = Glt::new(&tree, common::scene(), config).unwrap();
-    for _ in 0..3 {
-        for _ in 0..3000 {
-            let p = rng.point(9.0);
-            glt.record_light_at(p, LightId::Emitter(rng.below(30)), 1.0);
-        }
-        glt.refine();
-    }
+    let tree = LightTree::build(&lights_in_box(&mut rng, 30, 8.0), BuildHeuristic::Sarh).unwrap();
+    let mut glt = box_filter_glt(&tree, &mut rng);
     assert!(glt.memory().cells > 8);
     let collected = |glt: &Glt<&LightTree>| -> (f64, usize) {
         let sums = glt

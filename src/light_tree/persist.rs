@@ -4,7 +4,7 @@
 use super::LightTree;
 use super::hierarchy::LightHierarchy;
 use super::node::{LEAF_BIT, LightNode, NO_PARENT};
-use super::shape::shape_fingerprint;
+use super::shape::{hash_nodes, shape_fingerprint};
 use crate::math::Aabb;
 use crate::persist::{Kind, LoadError, Reader, Writer};
 use alloc::vec;
@@ -168,17 +168,10 @@ pub(crate) fn read_fingerprint<H: LightHierarchy + ?Sized>(
 /// A fingerprint of a light hierarchy: FNV-1a 64 over every node's
 /// children, emitter, power and decoded bounds, in node order. Equal
 /// hierarchies (the same lights built the same way) have equal
-/// fingerprints; learned state is only loaded against its own.
+/// fingerprints; before format version 4, learned state was only loaded
+/// against its own (now: [`shape_fingerprint`]).
 pub fn fingerprint<H: LightHierarchy + ?Sized>(tree: &H) -> u64 {
-    let mut h = crate::persist::Fnv::new();
-    let n = tree.node_count();
-    h.u32(n as u32);
-    h.u32(tree.emitter_count() as u32);
-    for i in 0..n as u32 {
-        let [l, r] = tree.children(i).unwrap_or([u32::MAX; 2]);
-        h.u32(l);
-        h.u32(r);
-        h.u32(tree.emitter(i).unwrap_or(u32::MAX));
+    hash_nodes(tree, |h, i| {
         let b = tree.node_bounds(i);
         h.u32(b.power.to_bits());
         for v in [b.bounds.min, b.bounds.max, b.cone.axis] {
@@ -189,6 +182,5 @@ pub fn fingerprint<H: LightHierarchy + ?Sized>(tree: &H) -> u64 {
         h.u32(b.cone.cos_theta_o.to_bits());
         h.u32(b.cone.cos_theta_e.to_bits());
         h.u32(u32::from(b.two_sided));
-    }
-    h.finish()
+    })
 }

@@ -25,6 +25,16 @@ where
 /// Equal for a tree and its refits; what a saved GLT or field binds to
 /// (format version 4 on).
 pub fn shape_fingerprint<H: LightHierarchy + ?Sized>(tree: &H) -> u64 {
+    hash_nodes(tree, |_, _| {})
+}
+
+/// FNV-1a 64 over the node and emitter counts, then per node its children,
+/// its emitter and what `more` adds for it, in node order: the shape, and
+/// (through `more`) whatever else a fingerprint covers.
+pub(super) fn hash_nodes<H: LightHierarchy + ?Sized>(
+    tree: &H,
+    mut more: impl FnMut(&mut crate::persist::Fnv, u32),
+) -> u64 {
     let mut h = crate::persist::Fnv::new();
     let n = tree.node_count();
     h.u32(n as u32);
@@ -34,6 +44,7 @@ pub fn shape_fingerprint<H: LightHierarchy + ?Sized>(tree: &H) -> u64 {
         h.u32(l);
         h.u32(r);
         h.u32(tree.emitter(i).unwrap_or(u32::MAX));
+        more(&mut h, i);
     }
     h.finish()
 }
