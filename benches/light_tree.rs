@@ -1,9 +1,10 @@
-//! Light tree build time per heuristic at 1e3..1e6 emitters, and the tree's
-//! memory (bytes per node and per emitter).
+//! Light tree build time per heuristic at 1e3..1e6 emitters, the time to
+//! refit a built tree to moved emitters, and the tree's memory (bytes per
+//! node and per emitter).
 //!
 //! `cargo bench --bench light_tree` runs everything (about 6 minutes on a
 //! quiet 2-core machine, most of it the 1e6 builds); pass a filter such as
-//! `-- build/Sarh` to run less.
+//! `-- build/Sarh` or `-- refit` to run less.
 
 use criterion::{BenchmarkId, Criterion, SamplingMode, criterion_group, criterion_main};
 use guiding::light_tree::BuildHeuristic;
@@ -70,5 +71,35 @@ fn build(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, build);
+/// Refitting a SARH tree to its emitters moved (`LightTree::refit`, what a
+/// renderer does per frame instead of a build), beside the SARH build.
+fn refit(c: &mut Criterion) {
+    let mut group = c.benchmark_group("refit");
+    group
+        .sample_size(10)
+        .sampling_mode(SamplingMode::Flat)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(3));
+    for n in SIZES {
+        let scene = mixed_scene(n, 1);
+        let moved: Vec<guiding::Emitter> = scene
+            .iter()
+            .map(|e| guiding::Emitter {
+                bounds: guiding::Aabb::new(e.bounds.min + 0.1, e.bounds.max + 0.1),
+                ..*e
+            })
+            .collect();
+        let tree = LightTree::build(&scene, BuildHeuristic::Sarh).expect("valid scene");
+        group.bench_with_input(BenchmarkId::new("Sarh", n), &moved, |b, m| {
+            b.iter_batched_ref(
+                || tree.clone(),
+                |t| t.refit(black_box(m.as_slice())).expect("valid scene"),
+                criterion::BatchSize::LargeInput,
+            )
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, build, refit);
 criterion_main!(benches);
