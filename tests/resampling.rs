@@ -75,6 +75,71 @@ fn the_reservoir_keeps_each_candidate_with_its_share() {
     }
 }
 
+/// The target is the contribution times the renderer's factor: with
+/// factors, each candidate is kept with its share of `c_j * factor_j`
+/// (a target that divided by the factor would keep other shares).
+#[test]
+fn the_target_multiplies_the_factor() {
+    let n = 4;
+    let s = UniformSampler::new(n as usize);
+    let ctx = ShadingContext::at(Vec3::ZERO);
+    let (contributions, factors) = ([2.0f32, 1.0, 4.0, 0.5], [0.25f32, 3.0, 1.0, 8.0]);
+    let lights = [0u32, 1, 2, 3];
+    let cands = forcing(&lights, n);
+    let w: Vec<f64> = (0..4)
+        .map(|j| f64::from(contributions[j]) * f64::from(factors[j]))
+        .collect();
+    let total: f64 = w.iter().sum();
+    let grid = 1u32 << 14;
+    let mut kept = [0u32; 4];
+    for g in 0..grid {
+        let u = (g as f32 + 0.5) / grid as f32;
+        let r = resample(&s, &ctx, &cands, u, None, |_, j| {
+            let mut e = Evaluated::new(contributions[j], j);
+            e.factor = factors[j];
+            Some(e)
+        })
+        .unwrap();
+        kept[r.payload] += 1;
+    }
+    for j in 0..4 {
+        let share = f64::from(kept[j]) / f64::from(grid);
+        assert!(
+            (share - w[j] / total).abs() < 1e-3,
+            "{j}: {share} vs {}",
+            w[j] / total
+        );
+    }
+}
+
+/// A choice whose weight leaves `f32` (it would make the estimate infinite
+/// or zero) is no choice: `None`, never an infinite or zero weight.
+#[test]
+fn a_weight_outside_f32_is_no_choice() {
+    let s = UniformSampler::new(2);
+    let ctx = ShadingContext::at(Vec3::ZERO);
+    let cands = forcing(&[0, 1], 2);
+    // u = 0 keeps the last candidate offered; its target is 1e60 times
+    // below the total: the weight overflows.
+    let huge_then_tiny = [1e30f32, 1e-30];
+    let r = resample(&s, &ctx, &cands, 0.0, None, |_, j| {
+        Some(Evaluated::new(huge_then_tiny[j], j))
+    });
+    assert!(r.is_none(), "{:?}", r.map(|r| r.weight));
+    // The control: the same candidates the other way round keep a finite
+    // weight.
+    let r = resample(&s, &ctx, &cands, 0.0, None, |_, j| {
+        Some(Evaluated::new(huge_then_tiny[1 - j], j))
+    })
+    .unwrap();
+    assert!(r.weight > 0.0 && r.weight.is_finite());
+    // A BSDF density 1e60 times the light's: the weight underflows.
+    let r = resample(&s, &ctx, &cands[..1], 0.0, None, |_, j| {
+        Some(Evaluated::new(1.0, j).with_densities(1e-30, 1e30))
+    });
+    assert!(r.is_none(), "{:?}", r.map(|r| r.weight));
+}
+
 /// One candidate: the sampler's own choice, weight 1 / pmf.
 #[test]
 fn one_candidate_is_plain_sampling() {
