@@ -72,7 +72,9 @@ impl<H: LightHierarchy> Glt<H> {
     /// lights' new powers and bounds at once, and a light that was dark
     /// and now shines is reachable through the prior. O(light-tree nodes).
     /// [`Error::LightTreeShape`] for a tree of another shape (a rebuild,
-    /// other lights), and nothing changes.
+    /// other lights), and nothing changes. The lights have changed, so
+    /// what the cells counted before describes the old ones: every cell
+    /// takes part in the next refinement ([`Glt::restart`]).
     ///
     /// ```
     /// # use guiding::{Aabb, BuildHeuristic, Emitter, Glt, GltConfig, LightTree};
@@ -93,10 +95,6 @@ impl<H: LightHierarchy> Glt<H> {
     /// glt.set_light_tree(tree)?;
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
-    ///
-    /// The lights have changed, so what the cells counted before describes
-    /// the old ones: every cell takes part in the next refinement
-    /// ([`Glt::restart`]).
     pub fn set_light_tree(&mut self, tree: H) -> Result<H, Error> {
         let old = self
             .guide
