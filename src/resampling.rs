@@ -264,10 +264,9 @@ impl<T> Reservoir<T> {
         e: Evaluated<T>,
         bsdf: bool,
     ) {
+        // A contribution that is not positive and finite gives a weight
+        // that is not either: ignored below with every other bad weight.
         let c = f64::from(e.contribution);
-        if !(c > 0.0 && c.is_finite()) {
-            return;
-        }
         let Some(ratio) = e.bsdf_ratio() else {
             return;
         };
