@@ -96,6 +96,7 @@
 //! | random numbers for a record | none: the stochastic box filter (off by default for light records) takes its offset from a hash of the record (`src/spatial/jitter.rs`), so the same records learn the same state on any thread count |
 //! | an occluded sample, a light behind the surface, a BSDF that is zero (and the shadow ray skipped) | record 0 or nothing, never a shadow ray for the record's sake: a zero adds nothing to what is learned; it only counts as a sample for the split and refinement rules, which then follow where paths go rather than where light arrives |
 //! | when to call `refine` | after each of PPG's doubling iterations ([`Iterations`]); a renderer that renders each tile to completion, after every wave of tiles (as many as it has threads): a GLT cell refines once it holds 3/2 of its records before ([`Glt::refine`]) |
+//! | lights that moved or changed power since the last frame (same lights, same order) | [`LightTree::refit`] the guide's tree, then hand it over ([`Glt::set_light_tree`], [`GuidingField::set_light_tree`]): what was learned is kept and every cell refines on the new frame's records; when the refit's drift passes [`LightTree::REBUILD_RATIO`], build a new tree and guide instead. A saved guide loads over any refit of its tree (docs/format.md) |
 //! | the spatial threshold | [`GltConfig::default`]'s, measured for renderers (docs/experiments/tile-order.md) |
 //!
 //! ## Features
