@@ -606,6 +606,55 @@ fn spatial_split_copies_both_payloads() {
 
 /// Bad input is dropped, counted per kind and never stored, through the
 /// field and through a vertex; queries at non-finite points answer nothing.
+/// A split shares the cut's trust by where its light splats fell: a half
+/// with 2% of them (below the 5% a half needs for full trust) gets
+/// confidence 0.4, the other 1; each half counts its own octants' splats.
+#[test]
+fn a_split_shares_trust_by_where_the_light_splats_fell() {
+    let (_, tree) = rooms();
+    // 1000 radiance records: above 600, one split; its halves (500) are
+    // below the next level's threshold.
+    let config = config_with(600.0, SdTreeConfig::default());
+    let mut field = GuidingField::new(&tree, scene(), config).unwrap();
+    // Apart along every axis: in different halves whichever axis splits.
+    let (lower, upper) = (Vec3::splat(-5.0), Vec3::splat(5.0));
+    let dir = Vec3::new(0.2, 1.0, 0.1);
+    for (p, light_splats) in [(lower, 20), (upper, 980)] {
+        let v = field.vertex(&ShadingContext::at(p)).unwrap();
+        for _ in 0..500 {
+            v.direction.record_radiance(dir, 1.0, 1.0);
+        }
+        for _ in 0..light_splats {
+            field.record_light_at(p, LightId::Emitter(3), 2.0);
+        }
+    }
+    // Before the refinement, one cell counts every splat in the octants
+    // they fell in.
+    let counts = field.spatial().data_slice()[0].octant_splats();
+    assert_eq!(counts.iter().sum::<u64>(), 1000);
+    assert_eq!(counts.iter().filter(|&&c| c > 0).count(), 2, "{counts:?}");
+    assert!(counts.contains(&20) && counts.contains(&980), "{counts:?}");
+    let out = field.refine();
+    assert_eq!(out.splits, 1);
+    let confidence = |p: Vec3| {
+        field
+            .vertex(&ShadingContext::at(p))
+            .unwrap()
+            .light
+            .cut()
+            .confidence()
+    };
+    assert!(
+        (confidence(lower) - 0.4).abs() < 1e-6,
+        "{}",
+        confidence(lower)
+    );
+    assert_eq!(confidence(upper), 1.0);
+    for cell in field.spatial().data_slice() {
+        assert_eq!(cell.octant_splats(), [0; 8], "counts restart");
+    }
+}
+
 #[test]
 fn bad_input_is_dropped_and_counted() {
     let mut lights = two_rooms();
