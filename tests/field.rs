@@ -655,6 +655,48 @@ fn a_split_shares_trust_by_where_the_light_splats_fell() {
     }
 }
 
+/// `clear_records` zeroes what was recorded since the last refinement
+/// (light sums, octant counts, radiance sums, drop counts) and keeps what
+/// was learned: the field samples as before.
+#[test]
+fn clearing_records_keeps_what_was_learned() {
+    let (_, tree) = rooms();
+    let config = config_with(600.0, SdTreeConfig::default());
+    let mut field = GuidingField::new(&tree, scene(), config).unwrap();
+    let p = Vec3::new(-5.0, 2.0, 1.0);
+    let dir = Vec3::new(0.2, 1.0, 0.1);
+    let record = |field: &GuidingField<&LightTree>| {
+        let v = field.vertex(&ShadingContext::at(p)).unwrap();
+        for _ in 0..300 {
+            v.direction.record_radiance(dir, 1.0, 1.0);
+            field.record_light_at(p, LightId::Emitter(3), 2.0);
+        }
+        field.record_light_at(p, LightId::Emitter(3), f32::NAN);
+    };
+    record(&field);
+    field.refine();
+    record(&field);
+    let before = field
+        .vertex(&ShadingContext::at(p))
+        .unwrap()
+        .light
+        .pmf(&ShadingContext::at(p), LightId::Emitter(3));
+    assert!(field.dropped_records().total() > 0);
+    field.clear_records();
+    assert_eq!(field.dropped_records().total(), 0);
+    for cell in field.spatial().data_slice() {
+        assert_eq!(cell.cut().accumulated(), (0.0, 0.0));
+        assert_eq!(cell.octant_splats(), [0; 8]);
+        assert_eq!(cell.sd().building_weight(), 0.0);
+    }
+    let after = field
+        .vertex(&ShadingContext::at(p))
+        .unwrap()
+        .light
+        .pmf(&ShadingContext::at(p), LightId::Emitter(3));
+    assert_eq!(before.to_bits(), after.to_bits());
+}
+
 #[test]
 fn bad_input_is_dropped_and_counted() {
     let mut lights = two_rooms();
