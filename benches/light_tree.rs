@@ -6,7 +6,10 @@
 //! quiet 2-core machine, most of it the 1e6 builds); pass a filter such as
 //! `-- build/Sarh` or `-- refit` to run less.
 
-use criterion::{BenchmarkId, Criterion, SamplingMode, criterion_group, criterion_main};
+use criterion::measurement::WallTime;
+use criterion::{
+    BenchmarkGroup, BenchmarkId, Criterion, SamplingMode, criterion_group, criterion_main,
+};
 use guiding::light_tree::BuildHeuristic;
 use guiding::{LightHierarchy, LightTree};
 use std::hint::black_box;
@@ -52,14 +55,21 @@ fn report_memory() {
     }
 }
 
-fn build(c: &mut Criterion) {
-    report_memory();
-    let mut group = c.benchmark_group("build");
+/// A benchmark group of 10 flat samples of about 3 s (the 1e6 builds take
+/// seconds each).
+fn group<'a>(c: &'a mut Criterion, name: &str) -> BenchmarkGroup<'a, WallTime> {
+    let mut group = c.benchmark_group(name);
     group
         .sample_size(10)
         .sampling_mode(SamplingMode::Flat)
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(3));
+    group
+}
+
+fn build(c: &mut Criterion) {
+    report_memory();
+    let mut group = group(c, "build");
     for n in SIZES {
         let scene = mixed_scene(n, 1);
         for h in HEURISTICS {
@@ -74,12 +84,7 @@ fn build(c: &mut Criterion) {
 /// Refitting a SARH tree to its emitters moved (`LightTree::refit`, what a
 /// renderer does per frame instead of a build), beside the SARH build.
 fn refit(c: &mut Criterion) {
-    let mut group = c.benchmark_group("refit");
-    group
-        .sample_size(10)
-        .sampling_mode(SamplingMode::Flat)
-        .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(3));
+    let mut group = group(c, "refit");
     for n in SIZES {
         let scene = mixed_scene(n, 1);
         let moved: Vec<guiding::Emitter> = scene
