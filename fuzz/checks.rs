@@ -218,6 +218,11 @@ pub mod build {
                         8 => f32::from(c[39]) / 64.0,
                         _ => 1.0,
                     },
+                    // Flag bit 4: in the light sets of the flag byte.
+                    light_sets: match c[36] & 16 {
+                        16 => u64::from(c[36]),
+                        _ => u64::MAX,
+                    },
                 }
             })
             .collect();

@@ -56,6 +56,15 @@ pub trait Emitters {
     fn weight(&self, _i: usize) -> f32 {
         1.0
     }
+
+    /// The light sets emitter `i` belongs to, one bit per set (up to 64;
+    /// light linking): a shading point that receives only some sets
+    /// ([`ShadingContext::receives`](crate::ShadingContext)) is lit only by
+    /// the emitters of those sets. Every set by default (`u64::MAX`); 0
+    /// lights no point that receives a set.
+    fn light_sets(&self, _i: usize) -> u64 {
+        u64::MAX
+    }
 }
 
 /// A plain description of one emitter, for renderers that would rather hand
@@ -77,6 +86,9 @@ pub struct Emitter {
     /// The multiplier on how often it is chosen ([`Emitters::weight`]); 1
     /// from every constructor.
     pub weight: f32,
+    /// The light sets it belongs to ([`Emitters::light_sets`]); every set
+    /// from every constructor.
+    pub light_sets: u64,
 }
 
 impl Emitter {
@@ -90,6 +102,7 @@ impl Emitter {
             two_sided: false,
             delta: true,
             weight: 1.0,
+            light_sets: u64::MAX,
         }
     }
 
@@ -107,6 +120,7 @@ impl Emitter {
             two_sided: false,
             delta: false,
             weight: 1.0,
+            light_sets: u64::MAX,
         }
     }
 
@@ -204,6 +218,7 @@ impl Emitter {
             two_sided,
             delta,
             weight: 1.0,
+            light_sets: u64::MAX,
         }
     }
 
@@ -217,6 +232,7 @@ impl Emitter {
             two_sided: false,
             delta: false,
             weight: 1.0,
+            light_sets: u64::MAX,
         }
     }
 
@@ -224,6 +240,15 @@ impl Emitter {
     /// ([`Emitters::weight`]).
     pub fn with_weight(self, weight: f32) -> Self {
         Self { weight, ..self }
+    }
+
+    /// This emitter in the light sets of `mask` only
+    /// ([`Emitters::light_sets`]).
+    pub fn in_light_sets(self, mask: u64) -> Self {
+        Self {
+            light_sets: mask,
+            ..self
+        }
     }
 }
 
@@ -254,6 +279,9 @@ macro_rules! emitters_for_list {
             }
             fn weight(&self, i: usize) -> f32 {
                 self[i].weight
+            }
+            fn light_sets(&self, i: usize) -> u64 {
+                self[i].light_sets
             }
         }
     )*};

@@ -142,11 +142,13 @@ fn cone_bounds(node: &LightCone, e: &Emitter) -> Result<(), String> {
 fn check_tree(tree: &LightTree, emitters: &[Emitter]) -> Vec<usize> {
     let n = emitters.len();
     assert_eq!(tree.emitter_count(), n);
-    let bytes = tree.nodes().len() * 32 + n * 4;
+    let has_sets = emitters.iter().any(|e| e.light_sets != u64::MAX);
+    assert_eq!(tree.has_light_sets(), has_sets);
+    let bytes = tree.nodes().len() * (32 + if has_sets { 8 } else { 0 }) + n * 4;
     assert_eq!(
         tree.bytes(),
         bytes,
-        "bytes() must count nodes and leaf table"
+        "bytes() must count nodes, leaf table and light sets"
     );
     if n == 0 {
         assert_eq!(tree.root(), None);
@@ -226,6 +228,16 @@ fn check_tree(tree: &LightTree, emitters: &[Emitter]) -> Vec<usize> {
         assert_eq!(d.power, tree.power(i as u32));
     }
     assert_eq!(tree.scene_bounds(), exact[0]);
+
+    // Light sets: each node's is the union of its emitters'.
+    let mut sets = vec![0u64; nodes];
+    for node in (0..nodes as u32).rev() {
+        sets[node as usize] = match tree.children(node) {
+            Some([l, r]) => sets[l as usize] | sets[r as usize],
+            None => emitters[tree.emitter(node).unwrap() as usize].light_sets,
+        };
+        assert_eq!(tree.light_sets(node), sets[node as usize], "node {node}");
+    }
 
     // Powers: a leaf holds its emitter's power, an inner node the sum of
     // its children within f32 rounding, the root the total.
@@ -859,6 +871,10 @@ fn random_bit_patterns_never_panic() {
                     two_sided: r.f() < 0.5,
                     delta: false,
                     weight: if r.f() < 0.8 { 1.0 } else { any(&mut r) },
+                    light_sets: match r.bits() % 3 {
+                        0 => u64::MAX,
+                        _ => u64::from(r.bits()) << (r.bits() % 33),
+                    },
                 }
             })
             .collect();
@@ -1134,4 +1150,40 @@ fn refit_errors_leave_the_tree_unchanged() {
         .to_string()
         .contains("50 emitters, 49")
     );
+}
+
+// ---------------------------------------------------------------------------
+// Light sets (light linking)
+// ---------------------------------------------------------------------------
+
+#[test]
+fn light_sets_are_unions_that_refits_and_saves_keep() {
+    let mut r = Rand::new(77);
+    let scene: Vec<Emitter> = mixed_scene(500, 78)
+        .into_iter()
+        .map(|e| match r.below(3) {
+            0 => e,
+            _ => e.in_light_sets(1 << r.below(5)),
+        })
+        .collect();
+    for h in HEURISTICS {
+        let mut tree = build(&scene, h);
+        check_tree(&tree, &scene);
+        assert!(tree.has_light_sets());
+        let back = LightTree::from_bytes(&tree.to_bytes()).unwrap();
+        check_tree(&back, &scene);
+        assert_eq!(back.to_bytes(), tree.to_bytes());
+        // Lights change sets between frames: a refit follows.
+        let moved: Vec<Emitter> = scene
+            .iter()
+            .map(|e| e.in_light_sets(e.light_sets.rotate_left(1)))
+            .collect();
+        tree.refit(moved.as_slice()).unwrap();
+        check_tree(&tree, &moved);
+        // Back in every set: no sets kept at all.
+        let all: Vec<Emitter> = scene.iter().map(|e| e.in_light_sets(u64::MAX)).collect();
+        tree.refit(all.as_slice()).unwrap();
+        check_tree(&tree, &all);
+        assert!(!tree.has_light_sets());
+    }
 }

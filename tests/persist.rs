@@ -616,3 +616,40 @@ mod sd_and_field {
         assert!(loaded > 0);
     }
 }
+
+/// A light tree's saved light sets are checked: one per node, each inner
+/// node's the union of its children's (a flipped bit, checksum fixed, is
+/// refused naming the field), and a count of sets that is not the node
+/// count is refused.
+#[test]
+fn saved_light_sets_are_checked() {
+    let lights: Vec<guiding::Emitter> = two_rooms()
+        .into_iter()
+        .enumerate()
+        .map(|(i, e)| e.in_light_sets(1 << (i % 3)))
+        .collect();
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let bytes = tree.to_bytes();
+    let n = tree.nodes().len();
+    assert_eq!(
+        LightTree::from_bytes(&bytes).unwrap().to_bytes(),
+        bytes,
+        "round trip"
+    );
+    // The sets are the payload's last 8 n bytes; the first is the root's.
+    let root_set = bytes.len() - 8 * n;
+    let mut bad = bytes.clone();
+    bad[root_set] ^= 0x40;
+    match LightTree::from_bytes(&resealed(bad)) {
+        Err(LoadError::Invalid { field, .. }) => assert_eq!(field, "light tree: light sets"),
+        other => panic!("{other:?}"),
+    }
+    // One set fewer than nodes: the count says n - 1, the bytes end early
+    // for the checksum's sake.
+    let mut short = bytes[..bytes.len() - 8].to_vec();
+    let count_at = root_set - 8;
+    short[count_at..count_at + 8].copy_from_slice(&((n - 1) as u64).to_le_bytes());
+    let len = (short.len() - HEADER) as u64;
+    short[HEADER - 16..HEADER - 8].copy_from_slice(&len.to_le_bytes());
+    assert!(LightTree::from_bytes(&resealed(short)).is_err());
+}

@@ -48,6 +48,19 @@ pub trait LightHierarchy {
     /// Number of emitters (leaves).
     fn emitter_count(&self) -> usize;
 
+    /// The light sets of the emitters below `node` (the union of theirs,
+    /// see [`Emitters::light_sets`](crate::Emitters::light_sets)); every
+    /// set by default.
+    fn light_sets(&self, _node: u32) -> u64 {
+        u64::MAX
+    }
+
+    /// Whether some emitter is not in every light set (else the walks skip
+    /// the sets entirely); false by default.
+    fn has_light_sets(&self) -> bool {
+        false
+    }
+
     /// The root-to-leaf path of `emitter`, at any depth; `None` when out of
     /// range.
     fn path(&self, emitter: u32) -> Option<EmitterPath> {
@@ -115,6 +128,14 @@ macro_rules! forward_hierarchy {
             #[inline(always)]
             fn path(&self, emitter: u32) -> Option<EmitterPath> {
                 (**self).path(emitter)
+            }
+            #[inline(always)]
+            fn light_sets(&self, node: u32) -> u64 {
+                (**self).light_sets(node)
+            }
+            #[inline(always)]
+            fn has_light_sets(&self) -> bool {
+                (**self).has_light_sets()
             }
         }
     )*};

@@ -43,6 +43,12 @@ impl LightTree {
         for &l in &self.leaf_of {
             w.u32(l);
         }
+        // Version 4: each node's light sets, none when every node is in
+        // every set.
+        w.len(self.sets.len());
+        for &s in &self.sets {
+            w.u64(s);
+        }
     }
 
     pub(crate) fn read(r: &mut Reader<'_>) -> Result<Self, LoadError> {
@@ -77,6 +83,21 @@ impl LightTree {
         let depth = check_structure(&nodes, &leaf_of).map_err(|field| {
             Reader::invalid(field, if field.contains("leaf") { leaf_at } else { at })
         })?;
+        let sets = match r.version() {
+            4.. => {
+                let sets_at = r.offset();
+                let count = r.len("light tree: light set count", 8)?;
+                let mut sets = Vec::with_capacity(count);
+                for _ in 0..count {
+                    sets.push(r.u64("light tree: light sets")?);
+                }
+                if !check_sets(&nodes, &sets) {
+                    return Err(Reader::invalid("light tree: light sets", sets_at));
+                }
+                sets
+            }
+            _ => Vec::new(),
+        };
         let built_spread = super::build::spread(&nodes, &scene);
         Ok(Self {
             nodes,
@@ -84,8 +105,26 @@ impl LightTree {
             scene,
             depth,
             built_spread,
+            sets,
         })
     }
+}
+
+/// Whether `sets` are a tree's light sets: none, or one per node with each
+/// inner node's the union of its children's, and not every node in every
+/// set (that is saved as none).
+fn check_sets(nodes: &[LightNode], sets: &[u64]) -> bool {
+    if sets.is_empty() {
+        return true;
+    }
+    sets.len() == nodes.len()
+        && sets.iter().any(|&s| s != u64::MAX)
+        && nodes.iter().enumerate().all(|(i, n)| {
+            n.is_leaf() || {
+                let (l, r) = (i + 1, n.link() as usize);
+                sets[i] == sets[l] | sets[r]
+            }
+        })
 }
 
 /// Checks that `nodes` is one depth-first tree from node 0 whose leaves
@@ -166,7 +205,8 @@ pub(crate) fn read_fingerprint<H: LightHierarchy + ?Sized>(
 }
 
 /// A fingerprint of a light hierarchy: FNV-1a 64 over every node's
-/// children, emitter, power and decoded bounds, in node order. Equal
+/// children, emitter, power, decoded bounds and (when it has any) light
+/// sets, in node order. Equal
 /// hierarchies (the same lights built the same way) have equal
 /// fingerprints; before format version 4, learned state was only loaded
 /// against its own (now: [`shape_fingerprint`]).
@@ -182,5 +222,12 @@ pub fn fingerprint<H: LightHierarchy + ?Sized>(tree: &H) -> u64 {
         h.u32(b.cone.cos_theta_o.to_bits());
         h.u32(b.cone.cos_theta_e.to_bits());
         h.u32(u32::from(b.two_sided));
+        // Light sets only when there are any: fingerprints of trees without
+        // them are what they were.
+        if tree.has_light_sets() {
+            let s = tree.light_sets(i);
+            h.u32(s as u32);
+            h.u32((s >> 32) as u32);
+        }
     })
 }

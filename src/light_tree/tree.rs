@@ -22,6 +22,9 @@ pub struct LightTree {
     pub(super) depth: usize,
     /// The tree's spread (`build/refit.rs`) when it was built or loaded.
     pub(super) built_spread: f32,
+    /// Each node's light sets (the union of its emitters'); empty when
+    /// every emitter is in every set.
+    pub(super) sets: Vec<u64>,
 }
 
 impl LightTree {
@@ -63,9 +66,10 @@ impl LightTree {
     /// does, and [`BuildError::EmitterCount`] for another number of
     /// emitters; on an error the tree is unchanged.
     pub fn refit<E: Emitters + ?Sized>(&mut self, emitters: &E) -> Result<f32, BuildError> {
-        let (nodes, scene) = refit(self, emitters)?;
-        self.nodes = nodes;
-        self.scene = scene;
+        let refitted = refit(self, emitters)?;
+        self.nodes = refitted.nodes;
+        self.scene = refitted.scene;
+        self.sets = refitted.sets;
         let now = spread(&self.nodes, &self.scene);
         Ok(match (now, self.built_spread) {
             (now, built) if built > 0.0 => now / built,
@@ -98,6 +102,7 @@ impl LightTree {
     pub fn bytes(&self) -> usize {
         self.nodes.len() * core::mem::size_of::<LightNode>()
             + self.leaf_of.len() * core::mem::size_of::<u32>()
+            + self.sets.len() * core::mem::size_of::<u64>()
     }
 
     #[inline]
@@ -159,5 +164,18 @@ impl LightHierarchy for LightTree {
 
     fn emitter_count(&self) -> usize {
         self.leaf_of.len()
+    }
+
+    #[inline]
+    fn light_sets(&self, node: u32) -> u64 {
+        match self.sets.is_empty() {
+            true => u64::MAX,
+            false => self.sets.get(node as usize).copied().unwrap_or(0),
+        }
+    }
+
+    #[inline]
+    fn has_light_sets(&self) -> bool {
+        !self.sets.is_empty()
     }
 }

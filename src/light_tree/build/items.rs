@@ -21,6 +21,8 @@ pub(super) struct Item {
     pub(super) area: f32,
     pub(super) emitter: u32,
     pub(super) two_sided: bool,
+    /// The light sets it belongs to.
+    pub(super) sets: u64,
 }
 
 pub(super) fn validate<E: Emitters + ?Sized>(emitters: &E) -> Result<Vec<Item>, BuildError> {
@@ -79,6 +81,7 @@ pub(super) fn validate<E: Emitters + ?Sized>(emitters: &E) -> Result<Vec<Item>, 
             theta_o: safe_acos(cone.cos_theta_o),
             cone,
             two_sided: emitters.two_sided(i),
+            sets: emitters.light_sets(i),
             emitter: i as u32,
         });
     }

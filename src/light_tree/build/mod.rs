@@ -28,6 +28,8 @@ struct Aggregate {
     bounds: Aabb,
     cone: ConeBound,
     two_sided: bool,
+    /// The light sets of the emitters below (their union).
+    sets: u64,
     power: f64,
     link: u32,
     parent: u32,
@@ -75,6 +77,7 @@ fn build_with<E: Emitters + ?Sized>(
             scene: Aabb::EMPTY,
             depth: 0,
             built_spread: 0.0,
+            sets: Vec::new(),
         });
     }
     // Past this depth, splits become medians: keeps the build O(n log n) and
@@ -107,6 +110,7 @@ fn build_with<E: Emitters + ?Sized>(
                 bounds: it.bounds,
                 cone: ConeBound::of(&it.cone),
                 two_sided: it.two_sided,
+                sets: it.sets,
                 power: it.power as f64,
                 link: LEAF_BIT | it.emitter,
                 parent: t.parent,
@@ -126,6 +130,7 @@ fn build_with<E: Emitters + ?Sized>(
             bounds: Aabb::EMPTY,
             cone: ConeBound::sphere(0.0),
             two_sided: false,
+            sets: 0,
             power: 0.0,
             link: 0,
             parent: t.parent,
@@ -142,7 +147,7 @@ fn build_with<E: Emitters + ?Sized>(
     }
     drop(items);
     drop(scratch);
-    let (nodes, scene) = aggregate_and_encode(&mut agg)?;
+    let Encoded { nodes, scene, sets } = aggregate_and_encode(&mut agg)?;
     let built_spread = spread(&nodes, &scene);
     Ok(LightTree {
         nodes,
@@ -150,6 +155,7 @@ fn build_with<E: Emitters + ?Sized>(
         scene,
         depth,
         built_spread,
+        sets,
     })
 }
 
@@ -158,9 +164,13 @@ fn build_with<E: Emitters + ?Sized>(
 /// then quantises them against the root's bounds: the end of a build and
 /// all of a refit. Children come after their parent, so one reverse sweep
 /// aggregates.
-fn aggregate_and_encode(agg: &mut [Aggregate]) -> Result<(Vec<LightNode>, Aabb), BuildError> {
+fn aggregate_and_encode(agg: &mut [Aggregate]) -> Result<Encoded, BuildError> {
     if agg.is_empty() {
-        return Ok((Vec::new(), Aabb::EMPTY));
+        return Ok(Encoded {
+            nodes: Vec::new(),
+            scene: Aabb::EMPTY,
+            sets: Vec::new(),
+        });
     }
     for i in (0..agg.len()).rev() {
         if agg[i].link & LEAF_BIT != 0 {
@@ -171,6 +181,7 @@ fn aggregate_and_encode(agg: &mut [Aggregate]) -> Result<(Vec<LightNode>, Aabb),
         a.bounds = l.bounds.union(&r.bounds);
         a.cone = l.cone.union(&r.cone);
         a.two_sided = l.two_sided || r.two_sided;
+        a.sets = l.sets | r.sets;
         a.power = l.power + r.power;
     }
     if !((agg[0].power as f32).is_finite()) {
@@ -195,7 +206,21 @@ fn aggregate_and_encode(agg: &mut [Aggregate]) -> Result<(Vec<LightNode>, Aabb),
             )
         })
         .collect();
-    Ok((nodes, scene))
+    // The light sets per node only when some emitter is not in every set:
+    // no memory, and no work for the walks, otherwise.
+    let sets = match agg.iter().all(|a| a.sets == u64::MAX) {
+        true => Vec::new(),
+        false => agg.iter().map(|a| a.sets).collect(),
+    };
+    Ok(Encoded { nodes, scene, sets })
+}
+
+/// What [`aggregate_and_encode`] makes of the aggregated nodes.
+pub(super) struct Encoded {
+    pub(super) nodes: Vec<LightNode>,
+    pub(super) scene: Aabb,
+    /// Each node's light sets; empty when every node is in every set.
+    pub(super) sets: Vec<u64>,
 }
 
 /// Reorders `items` and returns where the right child starts (in

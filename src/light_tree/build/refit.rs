@@ -4,14 +4,14 @@
 
 use super::cone_bound::ConeBound;
 use super::items::validate;
-use super::{Aggregate, aggregate_and_encode};
+use super::{Aggregate, Encoded, aggregate_and_encode};
 use crate::emitter::Emitters;
 use crate::light_tree::node::{LEAF_BIT, LightNode};
 use crate::light_tree::{BuildError, LightTree};
 use crate::math::Aabb;
 use alloc::vec::Vec;
 
-/// The nodes and scene box of `tree`'s shape over `emitters` (the same
+/// The nodes, scene box and light sets of `tree`'s shape over `emitters` (the same
 /// count, emitter `i` on the leaf that held emitter `i`): every leaf from
 /// its emitter, every inner node aggregated as the build does, then
 /// quantised against the new root's bounds. Bit-identical to the build's
@@ -19,7 +19,7 @@ use alloc::vec::Vec;
 pub(in crate::light_tree) fn refit<E: Emitters + ?Sized>(
     tree: &LightTree,
     emitters: &E,
-) -> Result<(Vec<LightNode>, Aabb), BuildError> {
+) -> Result<Encoded, BuildError> {
     if emitters.len() != tree.leaf_of.len() {
         return Err(BuildError::EmitterCount {
             tree: tree.leaf_of.len(),
@@ -40,6 +40,7 @@ pub(in crate::light_tree) fn refit<E: Emitters + ?Sized>(
                     bounds: it.bounds,
                     cone: ConeBound::of(&it.cone),
                     two_sided: it.two_sided,
+                    sets: it.sets,
                     power: it.power as f64,
                     link,
                     parent,
@@ -48,6 +49,7 @@ pub(in crate::light_tree) fn refit<E: Emitters + ?Sized>(
                     bounds: Aabb::EMPTY,
                     cone: ConeBound::sphere(0.0),
                     two_sided: false,
+                    sets: 0,
                     power: 0.0,
                     link,
                     parent,
