@@ -332,6 +332,7 @@ proptest! {
                 let ctx = ShadingContext {
                     position: rng.point(12.0),
                     normal: normal.and_then(|n| n.try_normalize()),
+                    receives: u64::MAX,
                 };
                 let total = pmf_total(&guide, &cut, &ctx);
                 let expect = expected_total(&guide);

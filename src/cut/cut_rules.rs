@@ -39,6 +39,10 @@ pub struct CutRules<H: LightHierarchy> {
     importance: Option<ImportanceTable>,
     config: CutConfig,
     has_power: bool,
+    /// The light sets of both children of each walk-table pair (the
+    /// root's pair: the root's, twice); empty when the tree has no light
+    /// sets.
+    pair_sets: Vec<[u64; 2]>,
 }
 
 /// Encodes the split of a node with child powers `el`, `er`.
@@ -101,6 +105,16 @@ impl<H: LightHierarchy> CutRules<H> {
             .uses_importance()
             .then(|| ImportanceTable::new(lights, WalkTable::pair_nodes(lights).into_iter()));
         let has_power = lights.root().is_some_and(|r| lights.power(r) > 0.0);
+        let pair_sets = match lights.has_light_sets() {
+            false => Vec::new(),
+            true => WalkTable::pair_nodes(lights)
+                .into_iter()
+                .map(|pair| match pair {
+                    Some(nodes) => nodes.map(|n| lights.light_sets(n)),
+                    None => [lights.root().map_or(0, |r| lights.light_sets(r)); 2],
+                })
+                .collect(),
+        };
         Self {
             tree,
             split,
@@ -108,6 +122,7 @@ impl<H: LightHierarchy> CutRules<H> {
             importance,
             config,
             has_power,
+            pair_sets,
         }
     }
 
@@ -148,6 +163,7 @@ impl<H: LightHierarchy> CutRules<H> {
     pub fn bytes(&self) -> usize {
         self.split.len() * core::mem::size_of::<f32>()
             + self.walk.bytes()
+            + self.pair_sets.len() * core::mem::size_of::<[u64; 2]>()
             + self.importance.as_ref().map_or(0, ImportanceTable::bytes)
     }
 
@@ -156,6 +172,16 @@ impl<H: LightHierarchy> CutRules<H> {
     #[inline(always)]
     pub(crate) fn raw_split(&self, node: u32) -> f32 {
         self.split.get(node as usize).copied().unwrap_or(f32::NAN)
+    }
+
+    /// The light sets of the children in walk-table pair `k` (`u64::MAX`
+    /// each when the tree has none).
+    #[inline(always)]
+    pub(crate) fn pair_sets(&self, k: u32) -> [u64; 2] {
+        match self.pair_sets.get(k as usize) {
+            Some(&s) => s,
+            None => [u64::MAX; 2],
+        }
     }
 
     /// The light tree laid out for sampling walks.

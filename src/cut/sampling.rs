@@ -163,6 +163,14 @@ struct Products {
     prior: f64,
 }
 
+/// `pair` with each side times its factor in `seen`, renormalised; `None`
+/// where neither side keeps any probability.
+#[inline(always)]
+fn restrict(pair: Option<(f64, f64)>, (sl, sr): (f64, f64)) -> Option<(f64, f64)> {
+    let (l, r) = pair?;
+    Descent::probabilities(l * sl, r * sr)
+}
+
 /// The probability of `side` in a pair.
 #[inline]
 fn pick((pl, pr): (f64, f64), side: Side) -> f64 {
@@ -195,6 +203,10 @@ pub(crate) struct Rule<'b, H: LightHierarchy> {
     mixture: Mixture,
     /// The cell's learned fractions of the unbounded lights.
     unbounded: &'b [f32],
+    /// The light sets the point receives, when that restricts the tree's
+    /// emitters (light linking); `None` otherwise, and then no step reads
+    /// a set.
+    receives: Option<u64>,
 }
 
 impl<'b, H: LightHierarchy> Rule<'b, H> {
@@ -206,7 +218,13 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
         ctx: &'b ShadingContext,
     ) -> Self {
         let config = guide.config();
-        let mixture = Mixture::new(guide.has_power(), cut, config);
+        let tree = guide.light_tree();
+        let receives = (ctx.receives != u64::MAX && tree.has_light_sets()).then_some(ctx.receives);
+        // Emitters take part when some has power and, under light linking,
+        // some is in a set the point receives.
+        let emitters = guide.has_power()
+            && receives.is_none_or(|r| tree.root().is_some_and(|n| tree.light_sets(n) & r != 0));
+        let mixture = Mixture::new(emitters, cut, config);
         let modulate = config.modulation == Modulation::Importance && cut.modulated;
         let prior_importance = config.prior == Prior::Importance;
         Self {
@@ -225,7 +243,18 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
             prior: mixture.prior > 0.0,
             mixture,
             unbounded: &cut.unbounded,
+            receives,
         }
+    }
+
+    /// The factors of two children with light sets `sets` at the point: 1
+    /// where some emitter below may light it, else 0; `None` when nothing
+    /// restricts the choice.
+    #[inline(always)]
+    fn seen(&self, sets: [u64; 2]) -> Option<(f64, f64)> {
+        let r = self.receives?;
+        let f = |s: u64| f64::from(u8::from(s & r != 0));
+        Some((f(sets[0]), f(sets[1])))
     }
 
     #[inline(always)]
@@ -266,7 +295,25 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
     ///
     /// The children's importances are evaluated at most once per node.
     #[inline(always)]
-    fn step(&self, at: Cursor, split: f32) -> Step {
+    fn step(&self, at: Cursor, split: f32, seen: Option<(f64, f64)>) -> Step {
+        let step = self.unrestricted_step(at, split);
+        match seen {
+            None => step,
+            Some(s) => Step {
+                // Each component restricted to the sides that may light
+                // the point and renormalised (the prior's power where the
+                // learned choice had no mass on them), so each stays a
+                // distribution over the lights the point receives.
+                cut: restrict(step.cut, s).or_else(|| restrict(decode_split(split), s)),
+                prior: restrict(step.prior, s).or_else(|| restrict(decode_split(split), s)),
+                next: step.next,
+            },
+        }
+    }
+
+    /// [`Rule::step`] without light sets.
+    #[inline(always)]
+    fn unrestricted_step(&self, at: Cursor, split: f32) -> Step {
         let power = decode_split(split);
         let needs_importance = self.prior_importance
             || match at.cut {
@@ -367,19 +414,23 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
             prior: 1.0,
         };
         let walk = self.guide.walk();
-        let mut children = at.node.children().map(|k| walk.pair(k));
+        let mut children = at.node.children().map(|k| (k, walk.pair(k)));
         // The cut node the walk is in, and the slot it left the cut by
         // (the root's only slot when the cut has no nodes).
         let mut in_cut = at.cut.filter(|_| SUM).map(|_| 0u32);
         if SUM {
             *sum = 0;
         }
-        while let Some(pair) = children {
+        while let Some((k_pair, pair)) = children {
             // Load the next level for both sides before choosing: these
             // loads do not depend on `u`, so they overlap with this level's
             // choice instead of waiting for it (the walk is latency-bound).
             let grand = walk.grandchildren(pair);
-            let step = self.step(at, at.node.split);
+            let seen = match self.receives {
+                None => None,
+                Some(_) => self.seen(self.guide.pair_sets(k_pair)),
+            };
+            let step = self.step(at, at.node.split, seen);
             let cuts = self.cut_children(&step);
             let (pl, pr) = if use_cut { step.cut } else { step.prior }?;
             let side = d.choose_with(pl, pr);
@@ -395,7 +446,7 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
                 node: pair.0[k],
                 cut: cuts[k],
             };
-            children = at.node.children().map(|_| grand[k]);
+            children = at.node.children().map(|next| (next, grand[k]));
         }
         let emitter = at.node.emitter()?;
         Some((LightId::Emitter(emitter), m.emitter_pmf(p)))
@@ -427,7 +478,14 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
         // because it does not know the path in advance).
         let walk = self.guide.walk();
         for &(node, side) in path.steps() {
-            let step = self.step(at, self.guide.raw_split(node));
+            let seen = match self.receives {
+                None => None,
+                Some(_) => self
+                    .tree
+                    .children(node)
+                    .and_then(|c| self.seen(c.map(|n| self.tree.light_sets(n)))),
+            };
+            let step = self.step(at, self.guide.raw_split(node), seen);
             self.apply(&mut p, &step, side);
             if p.cut == 0.0 && (!self.prior || p.prior == 0.0) {
                 return 0.0;

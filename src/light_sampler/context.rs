@@ -16,6 +16,13 @@ pub struct ShadingContext {
     /// nothing from it only when all of it lies exactly in the tangent
     /// plane, where that cosine is 0 (see `crate::light_sampler::importance`).
     pub normal: Option<Vec3>,
+    /// The light sets the point is lit by, one bit per set (light
+    /// linking): only emitters in one of them
+    /// ([`Emitters::light_sets`](crate::Emitters::light_sets)) are chosen
+    /// here, every sampler's pmf exactly normalised over them. Every set
+    /// (`u64::MAX`) from every constructor; see
+    /// [`ShadingContext::lit_by`].
+    pub receives: u64,
 }
 
 impl ShadingContext {
@@ -24,6 +31,7 @@ impl ShadingContext {
         Self {
             position,
             normal: None,
+            receives: u64::MAX,
         }
     }
 
@@ -34,7 +42,24 @@ impl ShadingContext {
         Self {
             position,
             normal: normal.try_normalize(),
+            receives: u64::MAX,
         }
+    }
+
+    /// This context lit only by the emitters of the light sets in `mask`
+    /// (an object's light linking).
+    pub fn lit_by(self, mask: u64) -> Self {
+        Self {
+            receives: mask,
+            ..self
+        }
+    }
+
+    /// Whether a node or emitter whose light sets are `sets` may light
+    /// this point.
+    #[inline]
+    pub(crate) fn sees(&self, sets: u64) -> bool {
+        sets & self.receives != 0
     }
 
     /// A context on a surface whose `normal` is flipped, if needed, to the

@@ -264,6 +264,7 @@ mod tests {
             let ctx = ShadingContext {
                 position: at.position,
                 normal: n,
+                receives: u64::MAX,
             };
             importance(&ctx, &node(b, LightCone::SPHERE, 3.0))
         };
@@ -357,10 +358,12 @@ mod tests {
             ShadingContext {
                 position: Vec3::ONE,
                 normal: Some(Vec3::ZERO),
+                receives: u64::MAX,
             },
             ShadingContext {
                 position: Vec3::ONE,
                 normal: Some(Vec3::NAN),
+                receives: u64::MAX,
             },
         ];
         let nodes = [

@@ -42,17 +42,26 @@ impl<H: LightHierarchy> ImportanceTreeSampler<H> {
 
     /// The descent weights of children `l` and `r` at `ctx`: their
     /// importances, or their powers when those are both zero (or
-    /// unusable).
+    /// unusable); each times `seen` of the child (1, or 0 for a child with
+    /// no emitter in the light sets the point receives).
     #[inline]
-    fn weights(&self, ctx: &ShadingContext) -> impl Fn(u32, u32) -> (f64, f64) + '_ {
+    fn weights<'a>(
+        &'a self,
+        ctx: &ShadingContext,
+        seen: impl Fn(u32) -> f64 + 'a,
+    ) -> impl Fn(u32, u32) -> (f64, f64) + 'a {
         let q = Query::new(ctx);
         move |l, r| {
-            let il = q.importance(&self.tree.node_bounds(l));
-            let ir = q.importance(&self.tree.node_bounds(r));
+            let (sl, sr) = (seen(l), seen(r));
+            let il = q.importance(&self.tree.node_bounds(l)) * sl;
+            let ir = q.importance(&self.tree.node_bounds(r)) * sr;
             if Descent::probabilities(il, ir).is_some() {
                 (il, ir)
             } else {
-                (self.tree.power(l) as f64, self.tree.power(r) as f64)
+                (
+                    self.tree.power(l) as f64 * sl,
+                    self.tree.power(r) as f64 * sr,
+                )
             }
         }
     }
@@ -64,7 +73,14 @@ impl<H: LightHierarchy> LightSampler for ImportanceTreeSampler<H> {
         if !ctx.is_finite() {
             return None;
         }
-        tree_walk::sample(&self.tree, u, self.weights(ctx))
+        let tree = &self.tree;
+        match tree_walk::restriction(tree, ctx) {
+            None => tree_walk::sample(tree, None, u, self.weights(ctx, |_| 1.0)),
+            Some(r) => {
+                let seen = move |n| tree_walk::seen(tree, r, n);
+                tree_walk::sample(tree, Some(r), u, self.weights(ctx, seen))
+            }
+        }
     }
 
     #[inline]
@@ -72,7 +88,14 @@ impl<H: LightHierarchy> LightSampler for ImportanceTreeSampler<H> {
         if !ctx.is_finite() {
             return 0.0;
         }
-        tree_walk::pmf(&self.tree, light, self.weights(ctx))
+        let tree = &self.tree;
+        match tree_walk::restriction(tree, ctx) {
+            None => tree_walk::pmf(tree, None, light, self.weights(ctx, |_| 1.0)),
+            Some(r) => {
+                let seen = move |n| tree_walk::seen(tree, r, n);
+                tree_walk::pmf(tree, Some(r), light, self.weights(ctx, seen))
+            }
+        }
     }
 
     #[inline]

@@ -34,13 +34,31 @@ impl<H: LightHierarchy> PowerTreeSampler<H> {
     }
 }
 
+/// The power weights of the children of the emitters in the sets
+/// `receives` (a child with none weighs 0).
+#[inline]
+fn masked<H: LightHierarchy + ?Sized>(tree: &H, receives: u64) -> impl Fn(u32, u32) -> (f64, f64) + '_ {
+    let power = power_weights(tree);
+    move |l, r| {
+        let (pl, pr) = power(l, r);
+        (
+            pl * tree_walk::seen(tree, receives, l),
+            pr * tree_walk::seen(tree, receives, r),
+        )
+    }
+}
+
 impl<H: LightHierarchy> LightSampler for PowerTreeSampler<H> {
     #[inline]
     fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
         if !ctx.is_finite() {
             return None;
         }
-        tree_walk::sample(&self.tree, u, power_weights(&self.tree))
+        let tree = &self.tree;
+        match tree_walk::restriction(tree, ctx) {
+            None => tree_walk::sample(tree, None, u, power_weights(tree)),
+            Some(r) => tree_walk::sample(tree, Some(r), u, masked(tree, r)),
+        }
     }
 
     #[inline]
@@ -48,7 +66,11 @@ impl<H: LightHierarchy> LightSampler for PowerTreeSampler<H> {
         if !ctx.is_finite() {
             return 0.0;
         }
-        tree_walk::pmf(&self.tree, light, power_weights(&self.tree))
+        let tree = &self.tree;
+        match tree_walk::restriction(tree, ctx) {
+            None => tree_walk::pmf(tree, None, light, power_weights(tree)),
+            Some(r) => tree_walk::pmf(tree, Some(r), light, masked(tree, r)),
+        }
     }
 
     #[inline]

@@ -1,0 +1,166 @@
+//! Light linking: a shading point lit by some light sets
+//! (`ShadingContext::lit_by`) is lit only by the emitters of those sets
+//! (`Emitters::light_sets`). Every sampler then chooses only among them,
+//! its pmf exactly normalised over them and bit-equal to what sampling
+//! reports; a point that receives every set sees what it saw without sets.
+
+use glam::Vec3;
+use guiding::glt::{Glt, GltConfig};
+use guiding::light_sampler::{ImportanceTreeSampler, PowerTreeSampler};
+use guiding::light_tree::BuildHeuristic;
+use guiding::math::Aabb;
+use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
+
+mod common;
+use common::{LightsAt, Rand, chi_square_z, mixed_scene};
+
+/// 300 mixed lights: a quarter in set 0, a quarter in set 1, a quarter in
+/// both, a quarter in every set.
+fn linked_scene() -> Vec<Emitter> {
+    mixed_scene(300, 111)
+        .into_iter()
+        .enumerate()
+        .map(|(i, e)| e.in_light_sets([0b01, 0b10, 0b11, u64::MAX][i % 4]))
+        .collect()
+}
+
+fn bounds() -> Aabb {
+    Aabb::new(Vec3::splat(-60.0), Vec3::splat(60.0))
+}
+
+fn trained_glt<'a>(tree: &'a LightTree, lights: &[Emitter]) -> Glt<&'a LightTree> {
+    let mut glt = Glt::new(
+        tree,
+        bounds(),
+        GltConfig {
+            spatial_threshold: 1000.0,
+            ..GltConfig::default()
+        },
+    )
+    .unwrap();
+    let mut r = Rand::new(112);
+    let n = lights.len() as u32;
+    for _ in 0..3 {
+        for _ in 0..6000 {
+            let p = r.point(50.0);
+            let e = r.below(n);
+            let c = lights[e as usize].bounds.center();
+            let v = lights[e as usize].power / (c - p).length_squared().max(1.0);
+            glt.record_light_at(p, LightId::Emitter(e), v * n as f32);
+        }
+        glt.refine();
+    }
+    glt
+}
+
+/// The contract at `ctx` for `s` over `lights`: normalised over the lights
+/// the point receives (or nothing at all when it receives none), nothing
+/// else ever chosen, samples report their pmf exactly.
+fn check(name: &str, s: &dyn LightSampler, lights: &[Emitter], ctx: &ShadingContext, r: &mut Rand) {
+    let receives = |e: &Emitter| e.light_sets & ctx.receives != 0 && e.power > 0.0;
+    let any = lights.iter().any(receives);
+    let mut total = 0.0;
+    for (i, e) in lights.iter().enumerate() {
+        let p = s.pmf_exact(ctx, LightId::Emitter(i as u32));
+        if !receives(e) {
+            assert_eq!(p, 0.0, "{name}: light {i} is not lit by sets {:b}", ctx.receives);
+        }
+        total += p;
+    }
+    if any {
+        assert!((total - 1.0).abs() < 1e-6, "{name}: total {total}");
+    } else {
+        assert_eq!(total, 0.0, "{name}");
+        assert!(s.sample(ctx, 0.5).is_none(), "{name}");
+        return;
+    }
+    for _ in 0..50 {
+        let x = s.sample(ctx, r.f()).unwrap();
+        let LightId::Emitter(e) = x.light else { panic!() };
+        assert!(receives(&lights[e as usize]), "{name}: sampled light {e}");
+        assert_eq!(x.pmf.to_bits(), s.pmf(ctx, x.light).to_bits(), "{name}");
+    }
+}
+
+#[test]
+fn every_tree_sampler_and_the_glt_choose_only_what_the_point_receives() {
+    let lights = linked_scene();
+    let tree = LightTree::build(lights.as_slice(), BuildHeuristic::Sarh).unwrap();
+    assert!(guiding::LightHierarchy::has_light_sets(&tree));
+    let glt = trained_glt(&tree, &lights);
+    let fresh = Glt::new(&tree, bounds(), GltConfig::default()).unwrap();
+    let importance = ImportanceTreeSampler::new(&tree);
+    let power = PowerTreeSampler::new(&tree);
+    let mut r = Rand::new(113);
+    for _ in 0..25 {
+        let p = r.point(50.0);
+        for mask in [0b01u64, 0b10, 0b100, 0b11, 0, u64::MAX] {
+            for ctx in [
+                ShadingContext::at(p).lit_by(mask),
+                ShadingContext::on_surface(p, r.dir()).lit_by(mask),
+            ] {
+                check("importance", &importance, &lights, &ctx, &mut r);
+                check("power tree", &power, &lights, &ctx, &mut r);
+                let v = glt.light_at(p);
+                check("trained GLT", &v, &lights, &ctx, &mut r);
+                let v = fresh.light_at(p);
+                check("untrained GLT", &v, &lights, &ctx, &mut r);
+            }
+        }
+    }
+}
+
+/// The trained GLT's draws at a point lit by set 1 follow its pmf
+/// (chi-square), and the restriction is what excludes the other lights
+/// (the control: lit by every set, lights of set 0 only are chosen).
+#[test]
+fn the_restricted_glt_draws_what_its_pmf_says() {
+    let lights = linked_scene();
+    let tree = LightTree::build(lights.as_slice(), BuildHeuristic::Sarh).unwrap();
+    let glt = trained_glt(&tree, &lights);
+    let p = Vec3::new(5.0, -3.0, 12.0);
+    let v = glt.light_at(p);
+    let ctx = ShadingContext::at(p).lit_by(0b10);
+    let mut counts = vec![0u64; lights.len()];
+    let mut r = Rand::new(114);
+    for _ in 0..200_000 {
+        let LightId::Emitter(e) = v.sample(&ctx, r.f()).unwrap().light else {
+            panic!()
+        };
+        counts[e as usize] += 1;
+    }
+    let probs: Vec<f64> = (0..lights.len() as u32)
+        .map(|e| v.pmf_exact(&ctx, LightId::Emitter(e)))
+        .collect();
+    let (z, _) = chi_square_z(&counts, &probs).unwrap();
+    assert!(z < 4.0, "chi-square z {z}");
+    let all = ShadingContext::at(p);
+    let only_set_0 = (0..lights.len()).filter(|i| i % 4 == 0);
+    let outside: f64 = only_set_0
+        .map(|i| v.pmf_exact(&all, LightId::Emitter(i as u32)))
+        .sum();
+    assert!(outside > 0.05, "the control: {outside}");
+}
+
+/// Without restriction a tree with light sets samples bit for bit as the
+/// same tree without them.
+#[test]
+fn receiving_every_set_is_having_no_sets() {
+    let lights = linked_scene();
+    let plain: Vec<Emitter> = lights.iter().map(|e| e.in_light_sets(u64::MAX)).collect();
+    let a = LightTree::build(lights.as_slice(), BuildHeuristic::Sarh).unwrap();
+    let b = LightTree::build(plain.as_slice(), BuildHeuristic::Sarh).unwrap();
+    let (ga, gb) = (trained_glt(&a, &lights), trained_glt(&b, &plain));
+    let mut r = Rand::new(115);
+    for _ in 0..50 {
+        let p = r.point(50.0);
+        let ctx = ShadingContext::at(p);
+        let (va, vb) = (ga.light_at(p), gb.light_at(p));
+        let (ia, ib) = (ImportanceTreeSampler::new(&a), ImportanceTreeSampler::new(&b));
+        for e in 0..lights.len() as u32 {
+            let id = LightId::Emitter(e);
+            assert_eq!(va.pmf(&ctx, id).to_bits(), vb.pmf(&ctx, id).to_bits());
+            assert_eq!(ia.pmf(&ctx, id).to_bits(), ib.pmf(&ctx, id).to_bits());
+        }
+    }
+}
