@@ -63,7 +63,11 @@ fn check(name: &str, s: &dyn LightSampler, lights: &[Emitter], ctx: &ShadingCont
     for (i, e) in lights.iter().enumerate() {
         let p = s.pmf_exact(ctx, LightId::Emitter(i as u32));
         if !receives(e) {
-            assert_eq!(p, 0.0, "{name}: light {i} is not lit by sets {:b}", ctx.receives);
+            assert_eq!(
+                p, 0.0,
+                "{name}: light {i} is not lit by sets {:b}",
+                ctx.receives
+            );
         }
         total += p;
     }
@@ -76,7 +80,9 @@ fn check(name: &str, s: &dyn LightSampler, lights: &[Emitter], ctx: &ShadingCont
     }
     for _ in 0..50 {
         let x = s.sample(ctx, r.f()).unwrap();
-        let LightId::Emitter(e) = x.light else { panic!() };
+        let LightId::Emitter(e) = x.light else {
+            panic!()
+        };
         assert!(receives(&lights[e as usize]), "{name}: sampled light {e}");
         assert_eq!(x.pmf.to_bits(), s.pmf(ctx, x.light).to_bits(), "{name}");
     }
@@ -105,6 +111,31 @@ fn every_tree_sampler_and_the_glt_choose_only_what_the_point_receives() {
                 check("trained GLT", &v, &lights, &ctx, &mut r);
                 let v = fresh.light_at(p);
                 check("untrained GLT", &v, &lights, &ctx, &mut r);
+            }
+        }
+    }
+}
+
+/// The strategies by name honour the sets too: the uniform and power
+/// samplers (exactly, in O(n) per query at a point lit by some sets only),
+/// the light BVH and the GLT.
+#[test]
+fn every_strategy_chooses_only_what_the_point_receives() {
+    use guiding::{Strategy, UnboundedLights};
+    let lights = linked_scene();
+    let mut r = Rand::new(116);
+    for name in Strategy::NAMES {
+        let s = Strategy::new(name, lights.as_slice(), UnboundedLights::NONE, bounds()).unwrap();
+        for _ in 0..10 {
+            let p = r.point(50.0);
+            for mask in [0b01u64, 0b10, 0b100, 0, u64::MAX] {
+                check(
+                    name,
+                    &s,
+                    &lights,
+                    &ShadingContext::at(p).lit_by(mask),
+                    &mut r,
+                );
             }
         }
     }
@@ -156,7 +187,10 @@ fn receiving_every_set_is_having_no_sets() {
         let p = r.point(50.0);
         let ctx = ShadingContext::at(p);
         let (va, vb) = (ga.light_at(p), gb.light_at(p));
-        let (ia, ib) = (ImportanceTreeSampler::new(&a), ImportanceTreeSampler::new(&b));
+        let (ia, ib) = (
+            ImportanceTreeSampler::new(&a),
+            ImportanceTreeSampler::new(&b),
+        );
         for e in 0..lights.len() as u32 {
             let id = LightId::Emitter(e);
             assert_eq!(va.pmf(&ctx, id).to_bits(), vb.pmf(&ctx, id).to_bits());

@@ -55,13 +55,6 @@ impl ShadingContext {
         }
     }
 
-    /// Whether a node or emitter whose light sets are `sets` may light
-    /// this point.
-    #[inline]
-    pub(crate) fn sees(&self, sets: u64) -> bool {
-        sets & self.receives != 0
-    }
-
     /// A context on a surface whose `normal` is flipped, if needed, to the
     /// side of the outgoing direction `wo` (towards the viewer). The
     /// crate's samplers do not need it (they use `|cos|`); a custom

@@ -37,6 +37,64 @@ struct Bin {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PowerSampler {
     bins: Vec<Bin>,
+    /// Each emitter's light sets and weight, when some emitter is not in
+    /// every set (light linking): a point that receives some sets only is
+    /// answered from these, in O(n).
+    linked: Option<alloc::boxed::Box<Linked>>,
+}
+
+/// The emitters' light sets and weights, for points lit by some sets only.
+#[derive(Clone, Debug, Default, PartialEq)]
+struct Linked {
+    sets: Vec<u64>,
+    weights: Vec<f64>,
+}
+
+impl Linked {
+    /// The total weight of the emitters `receives` sees.
+    fn total(&self, receives: u64) -> f64 {
+        self.sets
+            .iter()
+            .zip(&self.weights)
+            .filter(|(s, _)| *s & receives != 0)
+            .map(|(_, w)| w)
+            .sum()
+    }
+
+    /// The pmf of emitter `i` at a point lit by `receives`, from `total`.
+    fn pmf(&self, i: usize, receives: u64, total: f64) -> f32 {
+        match (self.sets.get(i), self.weights.get(i)) {
+            (Some(s), Some(w)) if s & receives != 0 && total > 0.0 => pmf_to_f32(w / total),
+            _ => 0.0,
+        }
+    }
+
+    /// The inverse CDF of the emitters `receives` sees, in index order.
+    fn sample(&self, u: f32, receives: u64) -> Option<LightSample> {
+        let total = self.total(receives);
+        if total <= 0.0 {
+            return None;
+        }
+        let target = Descent::new(u).u() * total;
+        let mut acc = 0.0;
+        let mut last = None;
+        for (i, (s, w)) in self.sets.iter().zip(&self.weights).enumerate() {
+            if s & receives == 0 || *w <= 0.0 {
+                continue;
+            }
+            last = Some(i);
+            acc += w;
+            if target < acc {
+                break;
+            }
+        }
+        let i = last?;
+        let pmf = self.pmf(i, receives, total);
+        (pmf > 0.0).then_some(LightSample {
+            light: LightId::Emitter(i as u32),
+            pmf,
+        })
+    }
 }
 
 impl PowerSampler {
@@ -44,7 +102,21 @@ impl PowerSampler {
     /// ([`Emitters::weight`]; a product that is not a positive finite
     /// number counts as zero).
     pub fn new<E: Emitters + ?Sized>(emitters: &E) -> Self {
-        Self::from_powers((0..emitters.len()).map(|i| emitters.power(i) * emitters.weight(i)))
+        let powers = (0..emitters.len()).map(|i| emitters.power(i) * emitters.weight(i));
+        Self::from_powers(powers).linked_by(emitters)
+    }
+
+    /// This sampler with `emitters`' light sets, when some is not in every
+    /// set: a point lit by some sets only then chooses among their emitters
+    /// (exactly, in O(n) per query).
+    pub(crate) fn linked_by<E: Emitters + ?Sized>(mut self, emitters: &E) -> Self {
+        let n = emitters.len().min(self.bins.len());
+        let sets: Vec<u64> = (0..n).map(|i| emitters.light_sets(i)).collect();
+        if sets.iter().any(|&s| s != u64::MAX) {
+            let weights = self.bins.iter().map(|b| f64::from(b.pmf)).collect();
+            self.linked = Some(alloc::boxed::Box::new(Linked { sets, weights }));
+        }
+        self
     }
 
     /// A sampler over emitters `0..n` with the given powers (at most
@@ -68,6 +140,7 @@ impl PowerSampler {
         }
         Self {
             bins: alias_table(&weights, total),
+            linked: None,
         }
     }
 
@@ -147,6 +220,9 @@ impl LightSampler for PowerSampler {
         if n == 0 || !ctx.is_finite() {
             return None;
         }
+        if let Some(l) = self.linked.as_ref().filter(|_| ctx.receives != u64::MAX) {
+            return l.sample(u, ctx.receives);
+        }
         let x = Descent::new(u).u() * n as f64;
         // x >= 0, so truncation is floor (and avoids a libm call).
         let slot = x as usize;
@@ -168,6 +244,10 @@ impl LightSampler for PowerSampler {
     fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
         match light {
             _ if !ctx.is_finite() => 0.0,
+            LightId::Emitter(i) if ctx.receives != u64::MAX && self.linked.is_some() => {
+                let l = self.linked.as_ref().expect("checked");
+                l.pmf(i as usize, ctx.receives, l.total(ctx.receives))
+            }
             LightId::Emitter(i) => self.bins.get(i as usize).map_or(0.0, |b| b.pmf),
             LightId::Unbounded(_) => 0.0,
         }

@@ -37,7 +37,10 @@ impl<H: LightHierarchy> PowerTreeSampler<H> {
 /// The power weights of the children of the emitters in the sets
 /// `receives` (a child with none weighs 0).
 #[inline]
-fn masked<H: LightHierarchy + ?Sized>(tree: &H, receives: u64) -> impl Fn(u32, u32) -> (f64, f64) + '_ {
+fn masked<H: LightHierarchy + ?Sized>(
+    tree: &H,
+    receives: u64,
+) -> impl Fn(u32, u32) -> (f64, f64) + '_ {
     let power = power_weights(tree);
     move |l, r| {
         let (pl, pr) = power(l, r);

@@ -43,18 +43,20 @@ impl UniformSampler {
 
     /// A sampler over `emitters` that chooses each in proportion to its
     /// weight ([`Emitters::weight`]; one that is not a positive finite
-    /// number counts as zero): exactly [`UniformSampler::new`] when every
-    /// weight is 1, else an alias table of the weights (16 bytes per
-    /// emitter).
+    /// number counts as zero), and among the emitters of the light sets a
+    /// point receives ([`Emitters::light_sets`]): exactly
+    /// [`UniformSampler::new`] when every weight is 1 and every emitter in
+    /// every set, else an alias table of the weights (16 bytes per
+    /// emitter, and the sets).
     pub fn weighted<E: Emitters + ?Sized>(emitters: &E) -> Self {
         let n = emitters.len();
-        if (0..n).all(|i| emitters.weight(i) == 1.0) {
+        let plain = (0..n).all(|i| emitters.weight(i) == 1.0 && emitters.light_sets(i) == u64::MAX);
+        if plain {
             return Self::new(n);
         }
+        let weights = PowerSampler::from_powers((0..n).map(|i| emitters.weight(i)));
         Self {
-            weighted: Some(PowerSampler::from_powers(
-                (0..n).map(|i| emitters.weight(i)),
-            )),
+            weighted: Some(weights.linked_by(emitters)),
             ..Self::new(n)
         }
     }
