@@ -382,6 +382,21 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
     /// not need it does not track it).
     pub(crate) fn sample<const SUM: bool>(
         &self,
+        d: Descent,
+        sum: &mut usize,
+    ) -> Option<(LightId, f64)> {
+        // Two copies of the walk: without light sets (every scene without
+        // light linking) no step reads a set.
+        match self.receives {
+            None => self.sample_with::<SUM, false>(d, sum),
+            Some(_) => self.sample_with::<SUM, true>(d, sum),
+        }
+    }
+
+    /// [`Rule::sample`], reading the light sets when `LINKED`.
+    #[inline(always)]
+    fn sample_with<const SUM: bool, const LINKED: bool>(
+        &self,
         mut d: Descent,
         sum: &mut usize,
     ) -> Option<(LightId, f64)> {
@@ -426,9 +441,9 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
             // loads do not depend on `u`, so they overlap with this level's
             // choice instead of waiting for it (the walk is latency-bound).
             let grand = walk.grandchildren(pair);
-            let seen = match self.receives {
-                None => None,
-                Some(_) => self.seen(self.guide.pair_sets(k_pair)),
+            let seen = match LINKED {
+                false => None,
+                true => self.seen(self.guide.pair_sets(k_pair)),
             };
             let step = self.step(at, at.node.split, seen);
             let cuts = self.cut_children(&step);
@@ -454,6 +469,15 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
 
     /// The `f64` pmf of `light`: the same steps along its path.
     pub(crate) fn pmf(&self, light: LightId) -> f64 {
+        match self.receives {
+            None => self.pmf_with::<false>(light),
+            Some(_) => self.pmf_with::<true>(light),
+        }
+    }
+
+    /// [`Rule::pmf`], reading the light sets when `LINKED`.
+    #[inline(always)]
+    fn pmf_with<const LINKED: bool>(&self, light: LightId) -> f64 {
         let emitter = match light {
             LightId::Unbounded(i) => {
                 return self
@@ -478,9 +502,9 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
         // because it does not know the path in advance).
         let walk = self.guide.walk();
         for &(node, side) in path.steps() {
-            let seen = match self.receives {
-                None => None,
-                Some(_) => self
+            let seen = match LINKED {
+                false => None,
+                true => self
                     .tree
                     .children(node)
                     .and_then(|c| self.seen(c.map(|n| self.tree.light_sets(n)))),
