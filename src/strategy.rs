@@ -146,6 +146,10 @@ impl LightSampler for Strategy {
         }
     }
 
+    fn is_empty_at(&self, ctx: &ShadingContext) -> bool {
+        inner!(self, ctx, s => s.is_empty_at(ctx), true)
+    }
+
     #[inline]
     fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
         inner!(self, ctx, s => s.sample_exact(ctx, u), None)

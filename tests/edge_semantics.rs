@@ -65,7 +65,7 @@ fn check(name: &str, s: &dyn LightSampler, n: u32) {
         let nan_normal = ShadingContext {
             position: p,
             normal: Some(Vec3::NAN),
-            receives: u64::MAX,
+            ..ShadingContext::at(Vec3::ZERO)
         };
         let u = rng.f();
         assert_eq!(s.sample(&nan_normal, u), s.sample(&no_normal, u), "{name}");

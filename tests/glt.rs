@@ -332,7 +332,7 @@ proptest! {
                 let ctx = ShadingContext {
                     position: rng.point(12.0),
                     normal: normal.and_then(|n| n.try_normalize()),
-                    receives: u64::MAX,
+                    ..ShadingContext::at(Vec3::ZERO)
                 };
                 let total = pmf_total(&guide, &cut, &ctx);
                 let expect = expected_total(&guide);

@@ -916,12 +916,12 @@ fn some_points() -> Vec<ShadingContext> {
         ShadingContext {
             position: Vec3::ONE,
             normal: Some(Vec3::ZERO),
-            receives: u64::MAX,
+            ..ShadingContext::at(Vec3::ZERO)
         },
         ShadingContext {
             position: Vec3::ONE,
             normal: Some(Vec3::NAN),
-            receives: u64::MAX,
+            ..ShadingContext::at(Vec3::ZERO)
         },
     ]
 }

@@ -198,3 +198,121 @@ fn receiving_every_set_is_having_no_sets() {
         }
     }
 }
+
+/// The contract over emitters and `k` unbounded lights at `ctx`: the pmf
+/// sums to 1 over the lights the point is lit by (emitters of the sets it
+/// receives, unbounded lights of its unbounded mask) and is 0 elsewhere;
+/// where it is lit by none, nothing is chosen and `is_empty_at` says so.
+fn check_with_unbounded(
+    name: &str,
+    s: &dyn LightSampler,
+    lights: &[Emitter],
+    k: u32,
+    ctx: &ShadingContext,
+    r: &mut Rand,
+) {
+    let emitter_lit = |e: &Emitter| e.light_sets & ctx.receives != 0 && e.power > 0.0;
+    let unbounded_lit = |i: u32| i >= 64 || ctx.receives_unbounded & (1 << i) != 0;
+    let mut total = 0.0;
+    for (i, e) in lights.iter().enumerate() {
+        let p = s.pmf_exact(ctx, LightId::Emitter(i as u32));
+        assert!(emitter_lit(e) || p == 0.0, "{name}: emitter {i} at {ctx:?}");
+        total += p;
+    }
+    for i in 0..k {
+        let p = s.pmf_exact(ctx, LightId::Unbounded(i));
+        assert!(
+            unbounded_lit(i) || p == 0.0,
+            "{name}: unbounded {i} at {ctx:?}"
+        );
+        total += p;
+    }
+    let any = lights.iter().any(emitter_lit) || (0..k).any(unbounded_lit);
+    assert_eq!(s.is_empty_at(ctx), !any, "{name} at {ctx:?}");
+    if !any {
+        assert_eq!(total, 0.0, "{name}");
+        assert!(s.sample(ctx, r.f()).is_none(), "{name}");
+        return;
+    }
+    assert!(
+        (total - 1.0).abs() < 1e-6,
+        "{name}: total {total} at {ctx:?}"
+    );
+    for _ in 0..50 {
+        let x = s.sample(ctx, r.f()).unwrap();
+        match x.light {
+            LightId::Emitter(e) => assert!(emitter_lit(&lights[e as usize]), "{name}"),
+            LightId::Unbounded(i) => assert!(unbounded_lit(i), "{name}: drew unbounded {i}"),
+        }
+        assert_eq!(x.pmf.to_bits(), s.pmf(ctx, x.light).to_bits(), "{name}");
+    }
+}
+
+/// A sun and a sky linked like emitters: every strategy (the fixed-share
+/// wrapper around the uniform, power and BVH samplers, and the GLT with its
+/// learned shares, trained and fresh) gives the share of the lights a
+/// point is not lit by to those it is, exactly. The cases that matter: a
+/// point lit by no emitter (the unbounded lights take everything), by no
+/// unbounded light (the emitters do), by nothing at all.
+#[test]
+fn unbounded_lights_are_linked_and_the_shares_renormalised() {
+    use guiding::{Strategy, UnboundedLights};
+    let lights = linked_scene();
+    let sun_and_sky = UnboundedLights::new(2, 0.3).unwrap();
+    let mut r = Rand::new(117);
+    let mut strategies: Vec<Strategy> = Strategy::NAMES
+        .iter()
+        .map(|name| Strategy::new(name, lights.as_slice(), sun_and_sky, bounds()).unwrap())
+        .collect();
+    // Train the GLT a little, sun and sky included.
+    let n = lights.len() as u32;
+    for _ in 0..2 {
+        let glt = strategies[3].glt_mut().unwrap();
+        for _ in 0..4000 {
+            let p = r.point(50.0);
+            let light = match r.below(n + 2) {
+                e if e < n => LightId::Emitter(e),
+                i => LightId::Unbounded(i - n),
+            };
+            glt.record_light_at(p, light, 1.0);
+        }
+        glt.refine();
+    }
+    let fresh = Strategy::new("glt", lights.as_slice(), sun_and_sky, bounds()).unwrap();
+    strategies.push(fresh);
+    for s in &strategies {
+        for _ in 0..6 {
+            let p = r.point(50.0);
+            for sets in [0b01u64, 0b100, 0, u64::MAX] {
+                for unbounded in [0b01u64, 0b10, 0, u64::MAX] {
+                    let ctx = ShadingContext::at(p)
+                        .lit_by(sets)
+                        .lit_by_unbounded(unbounded);
+                    check_with_unbounded(s.name(), s, &lights, 2, &ctx, &mut r);
+                }
+            }
+        }
+    }
+}
+
+/// A point lit by no light set in a scene without light sets (every
+/// emitter is then in every set) is lit by no emitter, in every strategy;
+/// its unbounded lights still light it.
+#[test]
+fn a_point_lit_by_no_set_is_lit_by_no_emitter() {
+    use guiding::{Strategy, UnboundedLights};
+    let lights = mixed_scene(100, 118);
+    let mut r = Rand::new(119);
+    for name in Strategy::NAMES {
+        for (unbounded, k) in [
+            (UnboundedLights::NONE, 0),
+            (UnboundedLights::new(1, 0.2).unwrap(), 1),
+        ] {
+            let s = Strategy::new(name, lights.as_slice(), unbounded, bounds()).unwrap();
+            for _ in 0..5 {
+                let ctx = ShadingContext::at(r.point(50.0)).lit_by(0);
+                check_with_unbounded(name, &s, &lights, k, &ctx, &mut r);
+            }
+        }
+    }
+}

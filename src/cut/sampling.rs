@@ -119,6 +119,44 @@ impl Mixture {
         }
     }
 
+    /// This mixture among the lights a point is lit by: unbounded light
+    /// `i` only where `received(i)`, the emitters only where `emitters`;
+    /// the weights left renormalised (equal shares among the received
+    /// unbounded lights if none keeps weight), all 0 when nothing is left.
+    fn restricted(self, fractions: &[f32], received: impl Fn(u32) -> bool, emitters: bool) -> Self {
+        let k = fractions.len() as u32;
+        let kept = (0..k).filter(|&i| received(i)).count();
+        if kept == k as usize && emitters {
+            return self;
+        }
+        let unbounded: f64 = (0..k)
+            .filter(|&i| received(i))
+            .map(|i| self.unbounded_pmf(fractions[i as usize]))
+            .sum();
+        let (cut, prior) = if emitters {
+            (self.cut, self.prior)
+        } else {
+            (0.0, 0.0)
+        };
+        let total = unbounded + cut + prior;
+        if total > 0.0 {
+            return Self {
+                unbounded: unbounded / total,
+                learned: self.learned / total,
+                floor: self.floor / total,
+                cut: cut / total,
+                prior: prior / total,
+            };
+        }
+        Self {
+            unbounded: if kept > 0 { 1.0 } else { 0.0 },
+            learned: 0.0,
+            floor: if kept > 0 { 1.0 / kept as f64 } else { 0.0 },
+            cut: 0.0,
+            prior: 0.0,
+        }
+    }
+
     /// The pmf of an emitter from its two products. Sampling and
     /// evaluation both end here.
     #[inline]
@@ -182,7 +220,7 @@ fn pick((pl, pr): (f64, f64), side: Side) -> f64 {
 
 /// Everything one query needs: the guiding tree, the cell's cut nodes, the
 /// rule below the cut and the shading point.
-pub(crate) struct Rule<'b, H: LightHierarchy> {
+struct Rule<'b, H: LightHierarchy, R: Restriction> {
     guide: &'b CutRules<H>,
     tree: &'b H,
     nodes: &'b [CutNode],
@@ -203,28 +241,112 @@ pub(crate) struct Rule<'b, H: LightHierarchy> {
     mixture: Mixture,
     /// The cell's learned fractions of the unbounded lights.
     unbounded: &'b [f32],
-    /// The light sets the point receives, when that restricts the tree's
-    /// emitters (light linking); `None` otherwise, and then no step reads
-    /// a set.
-    receives: Option<u64>,
+    /// The emitters the point may be lit by.
+    restriction: R,
 }
 
-impl<'b, H: LightHierarchy> Rule<'b, H> {
-    /// The rule for `cut` at `ctx`.
+/// Which emitters a point may be lit by: every one ([`Unrestricted`], a
+/// type of no size, so a walk without light sets reads none) or those in
+/// the light sets it receives ([`Receives`]).
+trait Restriction: Copy {
+    /// Whether any step reads a light set.
+    const LINKED: bool;
+
+    /// `step` at a node whose split-table entry is `split` and whose
+    /// children have the light sets `sets` returns: each component
+    /// restricted to the sides that may light the point and renormalised.
+    fn restrict(self, step: Step, split: f32, sets: impl FnOnce() -> Option<[u64; 2]>) -> Step;
+
+    /// Whether emitters with light sets `sets` may light the point.
+    fn reaches(self, sets: u64) -> bool;
+
+    /// Whether unbounded light `i` may light the point.
+    fn unbounded(self, i: u32) -> bool;
+}
+
+/// Every emitter may light the point.
+#[derive(Clone, Copy)]
+struct Unrestricted;
+
+impl Restriction for Unrestricted {
+    const LINKED: bool = false;
+
+    #[inline(always)]
+    fn restrict(self, step: Step, _: f32, _: impl FnOnce() -> Option<[u64; 2]>) -> Step {
+        step
+    }
+
+    #[inline(always)]
+    fn reaches(self, _: u64) -> bool {
+        true
+    }
+
+    #[inline(always)]
+    fn unbounded(self, _: u32) -> bool {
+        true
+    }
+}
+
+/// Only emitters in one of these light sets (one bit per set) and the
+/// unbounded lights of the second mask may light the point
+/// ([`ShadingContext::receives`], [`ShadingContext::receives_unbounded`]).
+#[derive(Clone, Copy)]
+struct Receives(u64, u64);
+
+impl Restriction for Receives {
+    const LINKED: bool = true;
+
+    #[inline(always)]
+    fn restrict(self, step: Step, split: f32, sets: impl FnOnce() -> Option<[u64; 2]>) -> Step {
+        let Some(sets) = sets() else {
+            return step;
+        };
+        let f = |s: u64| f64::from(u8::from(self.reaches(s)));
+        let seen = (f(sets[0]), f(sets[1]));
+        // Where the learned choice had no mass on the sides that may light
+        // the point, the prior's power split takes over, so each component
+        // stays a distribution over the lights the point receives.
+        Step {
+            cut: restrict(step.cut, seen).or_else(|| restrict(decode_split(split), seen)),
+            prior: restrict(step.prior, seen).or_else(|| restrict(decode_split(split), seen)),
+            next: step.next,
+        }
+    }
+
+    #[inline(always)]
+    fn reaches(self, sets: u64) -> bool {
+        sets & self.0 != 0
+    }
+
+    #[inline(always)]
+    fn unbounded(self, i: u32) -> bool {
+        i >= 64 || self.1 & (1 << i) != 0
+    }
+}
+
+impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
+    /// The rule for `cut` at `ctx`, choosing among the emitters
+    /// `restriction` lets light it.
     #[inline]
     pub(crate) fn new(
         guide: &'b CutRules<H>,
         cut: &'b GuidingCut,
         ctx: &'b ShadingContext,
+        restriction: R,
     ) -> Self {
         let config = guide.config();
-        let tree = guide.light_tree();
-        let receives = (ctx.receives != u64::MAX && tree.has_light_sets()).then_some(ctx.receives);
         // Emitters take part when some has power and, under light linking,
         // some is in a set the point receives.
         let emitters = guide.has_power()
-            && receives.is_none_or(|r| tree.root().is_some_and(|n| tree.light_sets(n) & r != 0));
-        let mixture = Mixture::new(emitters, cut, config);
+            && (!R::LINKED || {
+                let tree = guide.light_tree();
+                tree.root()
+                    .is_some_and(|n| restriction.reaches(tree.light_sets(n)))
+            });
+        let mut mixture = Mixture::new(emitters, cut, config);
+        if R::LINKED {
+            mixture = mixture.restricted(&cut.unbounded, |i| restriction.unbounded(i), emitters);
+        }
         let modulate = config.modulation == Modulation::Importance && cut.modulated;
         let prior_importance = config.prior == Prior::Importance;
         Self {
@@ -243,18 +365,8 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
             prior: mixture.prior > 0.0,
             mixture,
             unbounded: &cut.unbounded,
-            receives,
+            restriction,
         }
-    }
-
-    /// The factors of two children with light sets `sets` at the point: 1
-    /// where some emitter below may light it, else 0; `None` when nothing
-    /// restricts the choice.
-    #[inline(always)]
-    fn seen(&self, sets: [u64; 2]) -> Option<(f64, f64)> {
-        let r = self.receives?;
-        let f = |s: u64| f64::from(u8::from(s & r != 0));
-        Some((f(sets[0]), f(sets[1])))
     }
 
     #[inline(always)]
@@ -294,26 +406,10 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
     /// - The prior component takes the [`Prior`] rule (likewise).
     ///
     /// The children's importances are evaluated at most once per node.
+    ///
+    /// Light sets restrict it afterwards ([`Restriction::restrict`]).
     #[inline(always)]
-    fn step(&self, at: Cursor, split: f32, seen: Option<(f64, f64)>) -> Step {
-        let step = self.unrestricted_step(at, split);
-        match seen {
-            None => step,
-            Some(s) => Step {
-                // Each component restricted to the sides that may light
-                // the point and renormalised (the prior's power where the
-                // learned choice had no mass on them), so each stays a
-                // distribution over the lights the point receives.
-                cut: restrict(step.cut, s).or_else(|| restrict(decode_split(split), s)),
-                prior: restrict(step.prior, s).or_else(|| restrict(decode_split(split), s)),
-                next: step.next,
-            },
-        }
-    }
-
-    /// [`Rule::step`] without light sets.
-    #[inline(always)]
-    fn unrestricted_step(&self, at: Cursor, split: f32) -> Step {
+    fn step(&self, at: Cursor, split: f32) -> Step {
         let power = decode_split(split);
         let needs_importance = self.prior_importance
             || match at.cut {
@@ -382,21 +478,6 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
     /// not need it does not track it).
     pub(crate) fn sample<const SUM: bool>(
         &self,
-        d: Descent,
-        sum: &mut usize,
-    ) -> Option<(LightId, f64)> {
-        // Two copies of the walk: without light sets (every scene without
-        // light linking) no step reads a set.
-        match self.receives {
-            None => self.sample_with::<SUM, false>(d, sum),
-            Some(_) => self.sample_with::<SUM, true>(d, sum),
-        }
-    }
-
-    /// [`Rule::sample`], reading the light sets when `LINKED`.
-    #[inline(always)]
-    fn sample_with<const SUM: bool, const LINKED: bool>(
-        &self,
         mut d: Descent,
         sum: &mut usize,
     ) -> Option<(LightId, f64)> {
@@ -405,7 +486,10 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
             let (pu, pe) = Descent::probabilities(m.unbounded, m.cut + m.prior)?;
             if d.choose_with(pu, pe) == Side::Left {
                 let f = self.unbounded;
-                let weight = |i: u32| m.unbounded_pmf(f[i as usize]);
+                let weight = |i: u32| match self.restriction.unbounded(i) {
+                    true => m.unbounded_pmf(f[i as usize]),
+                    false => 0.0,
+                };
                 let i = choose_unbounded(&mut d, f.len() as u32, weight)?;
                 if SUM {
                     // After the cluster sums (`GuidingCut::first_unbounded_sum`).
@@ -429,23 +513,23 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
             prior: 1.0,
         };
         let walk = self.guide.walk();
-        let mut children = at.node.children().map(|k| (k, walk.pair(k)));
+        let mut children = at.node.children().map(|k| walk.pair(k));
         // The cut node the walk is in, and the slot it left the cut by
         // (the root's only slot when the cut has no nodes).
         let mut in_cut = at.cut.filter(|_| SUM).map(|_| 0u32);
         if SUM {
             *sum = 0;
         }
-        while let Some((k_pair, pair)) = children {
+        while let Some(pair) = children {
             // Load the next level for both sides before choosing: these
             // loads do not depend on `u`, so they overlap with this level's
             // choice instead of waiting for it (the walk is latency-bound).
             let grand = walk.grandchildren(pair);
-            let seen = match LINKED {
-                false => None,
-                true => self.seen(self.guide.pair_sets(k_pair)),
-            };
-            let step = self.step(at, at.node.split, seen);
+            let step =
+                self.restriction
+                    .restrict(self.step(at, at.node.split), at.node.split, || {
+                        at.node.children().map(|k| self.guide.pair_sets(k))
+                    });
             let cuts = self.cut_children(&step);
             let (pl, pr) = if use_cut { step.cut } else { step.prior }?;
             let side = d.choose_with(pl, pr);
@@ -461,7 +545,7 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
                 node: pair.0[k],
                 cut: cuts[k],
             };
-            children = at.node.children().map(|next| (next, grand[k]));
+            children = at.node.children().map(|_| grand[k]);
         }
         let emitter = at.node.emitter()?;
         Some((LightId::Emitter(emitter), m.emitter_pmf(p)))
@@ -469,20 +553,12 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
 
     /// The `f64` pmf of `light`: the same steps along its path.
     pub(crate) fn pmf(&self, light: LightId) -> f64 {
-        match self.receives {
-            None => self.pmf_with::<false>(light),
-            Some(_) => self.pmf_with::<true>(light),
-        }
-    }
-
-    /// [`Rule::pmf`], reading the light sets when `LINKED`.
-    #[inline(always)]
-    fn pmf_with<const LINKED: bool>(&self, light: LightId) -> f64 {
         let emitter = match light {
             LightId::Unbounded(i) => {
                 return self
                     .unbounded
                     .get(i as usize)
+                    .filter(|_| self.restriction.unbounded(i))
                     .map_or(0.0, |&f| self.mixture.unbounded_pmf(f));
             }
             LightId::Emitter(e) => e,
@@ -502,14 +578,12 @@ impl<'b, H: LightHierarchy> Rule<'b, H> {
         // because it does not know the path in advance).
         let walk = self.guide.walk();
         for &(node, side) in path.steps() {
-            let seen = match LINKED {
-                false => None,
-                true => self
-                    .tree
+            let split = self.guide.raw_split(node);
+            let step = self.restriction.restrict(self.step(at, split), split, || {
+                self.tree
                     .children(node)
-                    .and_then(|c| self.seen(c.map(|n| self.tree.light_sets(n)))),
-            };
-            let step = self.step(at, self.guide.raw_split(node), seen);
+                    .map(|c| c.map(|n| self.tree.light_sets(n)))
+            });
             self.apply(&mut p, &step, side);
             if p.cut == 0.0 && (!self.prior || p.prior == 0.0) {
                 return 0.0;
@@ -608,7 +682,34 @@ impl<H: LightHierarchy> CutRules<H> {
         if !ctx.is_finite() {
             return None;
         }
-        Rule::new(self, cut, ctx).sample::<SUM>(d, sum)
+        match self.receives(ctx) {
+            None => Rule::new(self, cut, ctx, Unrestricted).sample::<SUM>(d, sum),
+            Some(r) => self.sample_linked::<SUM>(cut, ctx, d, sum, r),
+        }
+    }
+
+    /// [`CutRules::sample_at`] at a point lit by some light sets: its own
+    /// copy of the walk, so the walk without sets reads none.
+    #[inline(never)]
+    fn sample_linked<const SUM: bool>(
+        &self,
+        cut: &GuidingCut,
+        ctx: &ShadingContext,
+        d: Descent,
+        sum: &mut usize,
+        receives: Receives,
+    ) -> Option<(LightId, f64)> {
+        Rule::new(self, cut, ctx, receives).sample::<SUM>(d, sum)
+    }
+
+    /// The light sets `ctx` receives, when they restrict this tree's
+    /// emitters (light linking).
+    #[inline(always)]
+    fn receives(&self, ctx: &ShadingContext) -> Option<Receives> {
+        let sets = ctx.restricts(self.light_tree().has_light_sets());
+        let k = self.config().unbounded.count;
+        let unbounded = ctx.receives_unbounded != u64::MAX && ctx.unbounded_received(k) < k;
+        (sets || unbounded).then_some(Receives(ctx.receives, ctx.receives_unbounded))
     }
 
     /// The probability that [`CutRules::sample`] chooses `light` at `ctx`
@@ -624,7 +725,23 @@ impl<H: LightHierarchy> CutRules<H> {
         if !ctx.is_finite() {
             return 0.0;
         }
-        Rule::new(self, cut, ctx).pmf(light)
+        match self.receives(ctx) {
+            None => Rule::new(self, cut, ctx, Unrestricted).pmf(light),
+            Some(r) => self.pmf_linked(cut, ctx, light, r),
+        }
+    }
+
+    /// [`CutRules::pmf_exact`] at a point lit by some light sets: its own
+    /// copy of the walk.
+    #[inline(never)]
+    fn pmf_linked(
+        &self,
+        cut: &GuidingCut,
+        ctx: &ShadingContext,
+        light: LightId,
+        receives: Receives,
+    ) -> f64 {
+        Rule::new(self, cut, ctx, receives).pmf(light)
     }
 }
 
@@ -633,5 +750,19 @@ impl<H: LightHierarchy> CutRules<H> {
     /// there is no unbounded light.
     pub fn is_empty(&self) -> bool {
         !self.has_power() && self.config().unbounded.count == 0
+    }
+
+    /// True when [`CutRules::sample`] chooses nothing at `ctx` (with any
+    /// cut): a position that is not finite, or no emitter with power in
+    /// the sets it receives and no unbounded light it receives.
+    pub fn is_empty_at(&self, ctx: &ShadingContext) -> bool {
+        let tree = self.light_tree();
+        let emitters = self.has_power()
+            && (!ctx.restricts(tree.has_light_sets())
+                || tree
+                    .root()
+                    .is_some_and(|n| tree.light_sets(n) & ctx.receives != 0));
+        !ctx.is_finite()
+            || (!emitters && ctx.unbounded_received(self.config().unbounded.count) == 0)
     }
 }

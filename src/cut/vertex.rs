@@ -219,6 +219,10 @@ impl<H: LightHierarchy> LightSampler for LightVertex<'_, H> {
         self.rules.is_empty()
     }
 
+    fn is_empty_at(&self, ctx: &ShadingContext) -> bool {
+        self.rules.is_empty_at(ctx)
+    }
+
     #[inline]
     fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
         self.rules.sample_exact(self.cut, ctx, u)

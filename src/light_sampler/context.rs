@@ -23,6 +23,13 @@ pub struct ShadingContext {
     /// (`u64::MAX`) from every constructor; see
     /// [`ShadingContext::lit_by`].
     pub receives: u64,
+    /// The unbounded lights the point is lit by, one bit per light (bit
+    /// `i`: [`LightId::Unbounded`](crate::LightId::Unbounded)`(i)`; those
+    /// from 64 on always light it): the renderer resolves its few
+    /// unbounded lights' links per object, the crate those of its many
+    /// emitters. Every one (`u64::MAX`) from every constructor; see
+    /// [`ShadingContext::lit_by_unbounded`].
+    pub receives_unbounded: u64,
 }
 
 impl ShadingContext {
@@ -32,6 +39,7 @@ impl ShadingContext {
             position,
             normal: None,
             receives: u64::MAX,
+            receives_unbounded: u64::MAX,
         }
     }
 
@@ -43,16 +51,66 @@ impl ShadingContext {
             position,
             normal: normal.try_normalize(),
             receives: u64::MAX,
+            receives_unbounded: u64::MAX,
         }
     }
 
-    /// This context lit only by the emitters of the light sets in `mask`
+    /// This context lit only by the emitters of the light sets in `sets`
     /// (an object's light linking).
-    pub fn lit_by(self, mask: u64) -> Self {
+    ///
+    /// ```
+    /// use guiding::light_sampler::PowerSampler;
+    /// use guiding::{glam::Vec3, Emitter, LightId, LightSampler, ShadingContext};
+    /// let lamps = [
+    ///     Emitter::point(Vec3::ZERO, 1.0).in_light_sets(0b01),
+    ///     Emitter::point(Vec3::X, 3.0).in_light_sets(0b10),
+    /// ];
+    /// let sampler = PowerSampler::new(&lamps[..]);
+    /// let ctx = ShadingContext::at(Vec3::Y).lit_by(0b10);
+    /// assert_eq!(sampler.pmf(&ctx, LightId::Emitter(0)), 0.0);
+    /// assert_eq!(sampler.pmf(&ctx, LightId::Emitter(1)), 1.0);
+    /// ```
+    pub fn lit_by(self, sets: u64) -> Self {
         Self {
-            receives: mask,
+            receives: sets,
             ..self
         }
+    }
+
+    /// This context lit only by the unbounded lights in `lights` (bit `i`:
+    /// [`LightId::Unbounded`](crate::LightId::Unbounded)`(i)`), its
+    /// emitters unchanged: a sun linked away from an object.
+    pub fn lit_by_unbounded(self, lights: u64) -> Self {
+        Self {
+            receives_unbounded: lights,
+            ..self
+        }
+    }
+
+    /// Whether the light sets the point receives exclude some emitter of a
+    /// hierarchy that `has_light_sets` (an emitter of one without is in
+    /// every set, so only a point that receives none excludes it).
+    #[inline]
+    pub(crate) fn restricts(&self, has_light_sets: bool) -> bool {
+        self.receives != u64::MAX && (has_light_sets || self.receives == 0)
+    }
+
+    /// Whether unbounded light `i` may light the point.
+    #[inline]
+    pub(crate) fn receives_unbounded(&self, i: u32) -> bool {
+        i >= 64 || self.receives_unbounded & (1 << i) != 0
+    }
+
+    /// How many of unbounded lights `0..count` may light the point.
+    #[inline]
+    pub(crate) fn unbounded_received(&self, count: u32) -> u32 {
+        let below = count.min(64);
+        let mask = if below == 64 {
+            u64::MAX
+        } else {
+            (1u64 << below) - 1
+        };
+        (self.receives_unbounded & mask).count_ones() + (count - below)
     }
 
     /// A context on a surface whose `normal` is flipped, if needed, to the

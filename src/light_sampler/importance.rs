@@ -264,7 +264,7 @@ mod tests {
             let ctx = ShadingContext {
                 position: at.position,
                 normal: n,
-                receives: u64::MAX,
+                ..ShadingContext::at(Vec3::ZERO)
             };
             importance(&ctx, &node(b, LightCone::SPHERE, 3.0))
         };
@@ -358,12 +358,12 @@ mod tests {
             ShadingContext {
                 position: Vec3::ONE,
                 normal: Some(Vec3::ZERO),
-                receives: u64::MAX,
+                ..ShadingContext::at(Vec3::ZERO)
             },
             ShadingContext {
                 position: Vec3::ONE,
                 normal: Some(Vec3::NAN),
-                receives: u64::MAX,
+                ..ShadingContext::at(Vec3::ZERO)
             },
         ];
         let nodes = [

@@ -119,6 +119,17 @@ pub trait LightSampler {
     /// True when `sample` returns `None` at every shading point.
     fn is_empty(&self) -> bool;
 
+    /// True when `sample` returns `None` at `ctx`: the sampler is empty,
+    /// the position is not finite, or no light the point is lit by has
+    /// probability (light linking: [`ShadingContext::receives`]). A
+    /// sampler wrapping another (`WithUnbounded`) asks it to give the
+    /// wrapped lights' share to its own. The default answers
+    /// [`LightSampler::is_empty`] for every finite point: right for a
+    /// sampler that reads no light sets.
+    fn is_empty_at(&self, ctx: &ShadingContext) -> bool {
+        self.is_empty() || !ctx.is_finite()
+    }
+
     /// [`LightSampler::sample`] from an `f64` number (53 bits), returning
     /// the pmf before it is rounded to `f32`: equal bit for bit to
     /// [`LightSampler::pmf_exact`] of the chosen light. The GLT's samplers
@@ -171,6 +182,11 @@ macro_rules! forward_sampler {
             #[inline]
             fn is_empty(&self) -> bool {
                 (**self).is_empty()
+            }
+
+            #[inline]
+            fn is_empty_at(&self, ctx: &ShadingContext) -> bool {
+                (**self).is_empty_at(ctx)
             }
 
             #[inline]

@@ -220,8 +220,8 @@ impl LightSampler for PowerSampler {
         if n == 0 || !ctx.is_finite() {
             return None;
         }
-        if let Some(l) = self.linked.as_ref().filter(|_| ctx.receives != u64::MAX) {
-            return l.sample(u, ctx.receives);
+        if ctx.restricts(self.linked.is_some()) {
+            return self.linked.as_ref()?.sample(u, ctx.receives);
         }
         let x = Descent::new(u).u() * n as f64;
         // x >= 0, so truncation is floor (and avoids a libm call).
@@ -244,10 +244,10 @@ impl LightSampler for PowerSampler {
     fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
         match light {
             _ if !ctx.is_finite() => 0.0,
-            LightId::Emitter(i) if ctx.receives != u64::MAX && self.linked.is_some() => {
-                let l = self.linked.as_ref().expect("checked");
-                l.pmf(i as usize, ctx.receives, l.total(ctx.receives))
-            }
+            LightId::Emitter(i) if ctx.restricts(self.linked.is_some()) => match &self.linked {
+                Some(l) => l.pmf(i as usize, ctx.receives, l.total(ctx.receives)),
+                None => 0.0,
+            },
             LightId::Emitter(i) => self.bins.get(i as usize).map_or(0.0, |b| b.pmf),
             LightId::Unbounded(_) => 0.0,
         }
@@ -256,6 +256,17 @@ impl LightSampler for PowerSampler {
     #[inline]
     fn is_empty(&self) -> bool {
         self.bins.is_empty()
+    }
+
+    fn is_empty_at(&self, ctx: &ShadingContext) -> bool {
+        if self.is_empty() || !ctx.is_finite() {
+            return true;
+        }
+        match &self.linked {
+            _ if !ctx.restricts(self.linked.is_some()) => false,
+            Some(l) => l.total(ctx.receives) <= 0.0,
+            None => true,
+        }
     }
 }
 

@@ -102,4 +102,8 @@ impl<H: LightHierarchy> LightSampler for ImportanceTreeSampler<H> {
     fn is_empty(&self) -> bool {
         tree_walk::live_root(&self.tree).is_none()
     }
+
+    fn is_empty_at(&self, ctx: &ShadingContext) -> bool {
+        tree_walk::is_empty_at(&self.tree, ctx)
+    }
 }

@@ -23,7 +23,17 @@ pub(super) fn restriction<H: LightHierarchy + ?Sized>(
     tree: &H,
     ctx: &ShadingContext,
 ) -> Option<u64> {
-    (ctx.receives != u64::MAX && tree.has_light_sets()).then_some(ctx.receives)
+    ctx.restricts(tree.has_light_sets()).then_some(ctx.receives)
+}
+
+/// Whether a tree walk chooses nothing at `ctx`: no emitter with power,
+/// a position that is not finite, or no emitter in the sets it receives.
+pub(super) fn is_empty_at<H: LightHierarchy + ?Sized>(tree: &H, ctx: &ShadingContext) -> bool {
+    match live_root(tree) {
+        _ if !ctx.is_finite() => true,
+        None => true,
+        Some(root) => restriction(tree, ctx).is_some_and(|r| seen(tree, r, root) == 0.0),
+    }
 }
 
 /// 1 for a node some emitter of which is in one of the sets `receives`,

@@ -121,6 +121,11 @@ pub(crate) fn choose_unbounded(
 /// exactly like `S`. So the pmf sums to 1 (or to 0 when nothing can be
 /// sampled).
 ///
+/// Under light linking the same holds among the lights the point is lit
+/// by: `count` is the number of unbounded lights it receives
+/// ([`ShadingContext::receives_unbounded`]), and `S` counts as empty where
+/// it has no emitter for the point ([`LightSampler::is_empty_at`]).
+///
 /// One `u` does every choice: `u < p` picks an unbounded light (`u / p`
 /// then picks which), otherwise the rescaled `(u - p) / (1 - p)` drives
 /// `S`, with the same `f64` arithmetic in `sample` and `pmf` so both agree
@@ -155,16 +160,18 @@ impl<S: LightSampler> WithUnbounded<S> {
         self.unbounded
     }
 
-    /// (unbounded lights together, emitters) probabilities.
+    /// (unbounded lights together, emitters) probabilities at `ctx`, and
+    /// how many unbounded lights share the first.
     #[inline]
-    fn split(&self) -> (f64, f64) {
+    fn split(&self, ctx: &ShadingContext) -> (f64, f64, u32) {
         let p = self.unbounded.probability;
-        if self.unbounded.count == 0 {
-            (0.0, 1.0)
-        } else if self.inner.is_empty() {
-            (1.0, 0.0)
+        let k = ctx.unbounded_received(self.unbounded.count);
+        if k == 0 {
+            (0.0, 1.0, 0)
+        } else if self.inner.is_empty_at(ctx) {
+            (1.0, 0.0, k)
         } else {
-            (p, 1.0 - p)
+            (p, 1.0 - p, k)
         }
     }
 }
@@ -175,12 +182,12 @@ impl<S: LightSampler> LightSampler for WithUnbounded<S> {
         if !ctx.is_finite() {
             return None;
         }
-        let (pu, pe) = self.split();
+        let (pu, pe, k) = self.split(ctx);
         let mut d = Descent::new(u);
         let (light, pmf) = match d.choose_with(pu, pe) {
             Side::Left => {
-                let k = self.unbounded.count;
-                let i = choose_unbounded(&mut d, k, |_| 1.0)?;
+                let weight = |i| f64::from(u8::from(ctx.receives_unbounded(i)));
+                let i = choose_unbounded(&mut d, self.unbounded.count, weight)?;
                 (LightId::Unbounded(i), pu / f64::from(k))
             }
             Side::Right => {
@@ -200,10 +207,12 @@ impl<S: LightSampler> LightSampler for WithUnbounded<S> {
         if !ctx.is_finite() {
             return 0.0;
         }
-        let (pu, pe) = self.split();
+        let (pu, pe, k) = self.split(ctx);
         match light {
-            LightId::Unbounded(_) if self.unbounded.contains(light) => {
-                pmf_to_f32(pu / f64::from(self.unbounded.count))
+            LightId::Unbounded(i)
+                if self.unbounded.contains(light) && ctx.receives_unbounded(i) =>
+            {
+                pmf_to_f32(pu / f64::from(k))
             }
             LightId::Unbounded(_) => 0.0,
             // An empty inner sampler has `pe` 0 and every pmf 0.
@@ -214,6 +223,12 @@ impl<S: LightSampler> LightSampler for WithUnbounded<S> {
     #[inline]
     fn is_empty(&self) -> bool {
         self.unbounded.count == 0 && self.inner.is_empty()
+    }
+
+    #[inline]
+    fn is_empty_at(&self, ctx: &ShadingContext) -> bool {
+        !ctx.is_finite()
+            || (ctx.unbounded_received(self.unbounded.count) == 0 && self.inner.is_empty_at(ctx))
     }
 }
 

@@ -73,7 +73,8 @@ impl LightSampler for UniformSampler {
         if let Some(w) = &self.weighted {
             return w.sample(ctx, u);
         }
-        if self.is_empty() || !ctx.is_finite() {
+        // A point lit by no light set: every emitter here is in every set.
+        if self.is_empty() || !ctx.is_finite() || ctx.restricts(false) {
             return None;
         }
         let u = Descent::new(u).u();
@@ -90,7 +91,7 @@ impl LightSampler for UniformSampler {
         if let Some(w) = &self.weighted {
             return w.pmf(ctx, light);
         }
-        if !ctx.is_finite() {
+        if !ctx.is_finite() || ctx.restricts(false) {
             return 0.0;
         }
         match light {
@@ -104,6 +105,13 @@ impl LightSampler for UniformSampler {
         match &self.weighted {
             Some(w) => w.is_empty(),
             None => self.count == 0,
+        }
+    }
+
+    fn is_empty_at(&self, ctx: &ShadingContext) -> bool {
+        match &self.weighted {
+            Some(w) => w.is_empty_at(ctx),
+            None => self.count == 0 || !ctx.is_finite() || ctx.restricts(false),
         }
     }
 }
