@@ -26,7 +26,7 @@ use rayon::prelude::*;
 
 #[path = "../tests/common/mod.rs"]
 mod common;
-use common::{Rand, mixed_scene};
+use common::{Rand, contribution, mixed_scene};
 
 const LIGHTS: usize = 2000;
 const POINTS: usize = 200;
@@ -34,29 +34,6 @@ const POINTS: usize = 200;
 /// differs from another's over the same lights by some 20%.
 const SEEDS: u64 = 4;
 const FRAMES: [usize; 9] = [0, 1, 2, 4, 8, 16, 32, 64, 128];
-
-/// An unshadowed contribution of `e` at `p`: power over squared distance,
-/// times the emitter's cosine (Lambertian surfaces) or its cone (spots).
-fn contribution(e: &Emitter, p: Vec3) -> f64 {
-    let c = e.bounds.min * 0.5 + e.bounds.max * 0.5;
-    let d = p - c;
-    let d2 = d.length_squared().max(1.0) as f64;
-    let g = match e.cone {
-        None => 1.0,
-        Some(cone) => {
-            let cos = cone.axis.dot(d.normalize_or_zero());
-            let cos = if e.two_sided { cos.abs() } else { cos };
-            if cone.cos_theta_e <= 0.0 {
-                cos.max(0.0)
-            } else if cos >= cone.cos_theta_e {
-                1.0
-            } else {
-                0.0
-            }
-        }
-    };
-    e.power as f64 * g as f64 / d2
-}
 
 /// The exact relative variance per sample of choosing a light with the
 /// importance sampler over `tree` and estimating the sum of the lights'

@@ -156,6 +156,29 @@ pub fn scene() -> Aabb {
     Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0))
 }
 
+/// An unshadowed contribution of `e` at `p`: power over squared distance,
+/// times the emitter's cosine (Lambertian surfaces) or its cone (spots).
+pub fn contribution(e: &Emitter, p: Vec3) -> f64 {
+    let c = e.bounds.min * 0.5 + e.bounds.max * 0.5;
+    let d = p - c;
+    let d2 = d.length_squared().max(1.0) as f64;
+    let g = match e.cone {
+        None => 1.0,
+        Some(cone) => {
+            let cos = cone.axis.dot(d.normalize_or_zero());
+            let cos = if e.two_sided { cos.abs() } else { cos };
+            if cone.cos_theta_e <= 0.0 {
+                cos.max(0.0)
+            } else if cos >= cone.cos_theta_e {
+                1.0
+            } else {
+                0.0
+            }
+        }
+    };
+    e.power as f64 * g as f64 / d2
+}
+
 /// Contribution of light `e` at `p` in the two rooms.
 pub fn value(lights: &[Emitter], e: u32, p: Vec3) -> f32 {
     let c = lights[e as usize].bounds.center();
