@@ -43,8 +43,8 @@ impl LightTree {
         for &l in &self.leaf_of {
             w.u32(l);
         }
-        // Version 4: each node's light sets, none when every node is in
-        // every set.
+        // Since version 5: each node's light sets, none when every node is
+        // in every set.
         w.len(self.sets.len());
         for &s in &self.sets {
             w.u64(s);
@@ -84,7 +84,7 @@ impl LightTree {
             Reader::invalid(field, if field.contains("leaf") { leaf_at } else { at })
         })?;
         let sets = match r.version() {
-            4.. => {
+            5.. => {
                 let sets_at = r.offset();
                 let count = r.len("light tree: light set count", 8)?;
                 let mut sets = Vec::with_capacity(count);
