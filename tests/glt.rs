@@ -766,6 +766,73 @@ impl LightHierarchy for Chain {
     }
 }
 
+/// A chain whose leaf of emitter `hole` names no emitter: a custom
+/// hierarchy may have such a leaf.
+struct Holed {
+    chain: Chain,
+    hole: u32,
+}
+
+impl LightHierarchy for Holed {
+    fn root(&self) -> Option<u32> {
+        self.chain.root()
+    }
+    fn children(&self, node: u32) -> Option<[u32; 2]> {
+        self.chain.children(node)
+    }
+    fn parent(&self, node: u32) -> Option<u32> {
+        self.chain.parent(node)
+    }
+    fn power(&self, node: u32) -> f32 {
+        self.chain.power(node)
+    }
+    fn node_bounds(&self, node: u32) -> NodeBounds {
+        self.chain.node_bounds(node)
+    }
+    fn emitter(&self, node: u32) -> Option<u32> {
+        self.chain.emitter(node).filter(|&e| e != self.hole)
+    }
+    fn leaf(&self, emitter: u32) -> Option<u32> {
+        self.chain.leaf(emitter).filter(|_| emitter != self.hole)
+    }
+    fn node_count(&self) -> usize {
+        self.chain.node_count()
+    }
+    fn emitter_count(&self) -> usize {
+        self.chain.emitter_count()
+    }
+}
+
+/// A walk that reaches a leaf naming no emitter chooses nothing, never a
+/// light made up from the leaf's marker (the walk table marks such a leaf
+/// `BAD_LEAF`; reading it as an emitter would give `2^31 - 1`). The
+/// control: the hole is reached (some draws choose nothing).
+#[test]
+fn a_leaf_without_an_emitter_is_never_chosen() {
+    let holed = Holed {
+        chain: Chain::new(vec![1.0, 2.0, 3.0, 4.0, 5.0]),
+        hole: 3,
+    };
+    let guide = CutRules::new(&holed, CutConfig::default()).unwrap();
+    let cut = guide.new_cut();
+    let ctx = ShadingContext::at(Vec3::new(3.0, 0.0, 0.0));
+    let mut nothing = 0;
+    for i in 0..4000 {
+        let u = (i as f32 + 0.5) / 4000.0;
+        let Some(s) = guide.sample(&cut, &ctx, u) else {
+            nothing += 1;
+            continue;
+        };
+        let LightId::Emitter(e) = s.light else {
+            panic!("{:?}", s.light)
+        };
+        assert!(e < 5 && e != 3, "chose {e}");
+        assert_eq!(s.pmf.to_bits(), guide.pmf(&cut, &ctx, s.light).to_bits());
+    }
+    assert!(nothing > 0, "the hole was never reached");
+    assert_eq!(guide.pmf(&cut, &ctx, LightId::Emitter(3)), 0.0);
+}
+
 /// One uniform number per descent stays exact in distribution through the
 /// cut and the tree together, 100 levels deep: the cut covers the first 70
 /// levels, power descent the last 30. Chi-square over the 100 leaves
