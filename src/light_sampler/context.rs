@@ -97,7 +97,7 @@ impl ShadingContext {
 
     /// Whether unbounded light `i` may light the point.
     #[inline]
-    pub(crate) fn receives_unbounded(&self, i: u32) -> bool {
+    pub(crate) fn is_lit_by_unbounded(&self, i: u32) -> bool {
         i >= 64 || self.receives_unbounded & (1 << i) != 0
     }
 

@@ -186,7 +186,7 @@ impl<S: LightSampler> LightSampler for WithUnbounded<S> {
         let mut d = Descent::new(u);
         let (light, pmf) = match d.choose_with(pu, pe) {
             Side::Left => {
-                let weight = |i| f64::from(u8::from(ctx.receives_unbounded(i)));
+                let weight = |i| f64::from(u8::from(ctx.is_lit_by_unbounded(i)));
                 let i = choose_unbounded(&mut d, self.unbounded.count, weight)?;
                 (LightId::Unbounded(i), pu / f64::from(k))
             }
@@ -210,7 +210,7 @@ impl<S: LightSampler> LightSampler for WithUnbounded<S> {
         let (pu, pe, k) = self.split(ctx);
         match light {
             LightId::Unbounded(i)
-                if self.unbounded.contains(light) && ctx.receives_unbounded(i) =>
+                if self.unbounded.contains(light) && ctx.is_lit_by_unbounded(i) =>
             {
                 pmf_to_f32(pu / f64::from(k))
             }
