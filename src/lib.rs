@@ -205,7 +205,9 @@ pub use glam;
 
 // The lights and the shading point.
 pub use emitter::{Emitter, Emitters};
-pub use light_tree::{BuildError, BuildHeuristic, LightHierarchy, LightTree};
+pub use light_tree::{
+    BuildError, BuildHeuristic, Instance, InstancedLightTree, LightHierarchy, LightTree,
+};
 pub use math::{Aabb, Accumulation, luminance};
 // Choosing lights.
 pub use light_sampler::{LightId, LightSample, LightSampler, ShadingContext, UnboundedLights};

@@ -44,6 +44,13 @@ pub enum BuildError {
     },
     /// The total power (times the weights) does not fit in an `f32`.
     PowerOverflow,
+    /// An instance of an [`InstancedLightTree`](super::InstancedLightTree)
+    /// names no mesh, has a non-finite or singular transform, or a power
+    /// scale that is not a finite number >= 0.
+    InvalidInstance {
+        /// The instance's index.
+        instance: usize,
+    },
     /// [`LightTree::refit`](super::LightTree::refit) was given another
     /// number of emitters than the tree holds.
     EmitterCount {
@@ -79,6 +86,10 @@ impl fmt::Display for BuildError {
                 )
             }
             Self::PowerOverflow => f.write_str("the total emitted power overflows f32"),
+            Self::InvalidInstance { instance } => write!(
+                f,
+                "instance {instance} names no mesh, or its transform or power scale is invalid"
+            ),
             Self::EmitterCount { tree, given } => write!(
                 f,
                 "a refit needs the tree's {tree} emitters, {given} were given"

@@ -8,6 +8,10 @@ mod imp {
         x.sqrt()
     }
     #[inline]
+    pub fn cbrt(x: f32) -> f32 {
+        x.cbrt()
+    }
+    #[inline]
     pub fn sqrt64(x: f64) -> f64 {
         x.sqrt()
     }
@@ -50,6 +54,10 @@ mod imp {
     #[inline]
     pub fn sqrt(x: f32) -> f32 {
         libm::sqrtf(x)
+    }
+    #[inline]
+    pub fn cbrt(x: f32) -> f32 {
+        libm::cbrtf(x)
     }
     #[inline]
     pub fn sqrt64(x: f64) -> f64 {

@@ -1,0 +1,381 @@
+//! [`InstancedLightTree`]: a light tree over instances of emissive meshes,
+//! each instance's leaf continuing into its mesh's one shared tree.
+
+use super::BuildError;
+use super::build::BuildHeuristic;
+use super::hierarchy::{LightHierarchy, NodeBounds};
+use super::tree::LightTree;
+use crate::emitter::Emitter;
+use crate::math::scalar::cbrt;
+use crate::math::{Aabb, LightCone};
+use alloc::vec::Vec;
+use glam::{Affine3A, Vec3, Vec3A};
+
+/// One placement of an emissive mesh: which mesh, where, and how its
+/// emitters' powers scale there.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Instance {
+    /// The mesh's index in the list given to [`InstancedLightTree::build`].
+    pub mesh: u32,
+    /// Mesh space to world space: any invertible affine map. A mirroring
+    /// one (negative determinant) turns the emitters' windings, and so the
+    /// side a one-sided emitter emits on, as a renderer's triangle normals
+    /// computed from the placed corners turn (pbrt's handedness rule).
+    pub transform: Affine3A,
+    /// The factor the mesh's emitter powers take in this instance: the
+    /// transform's area scale (`s^2` for a uniform scale `s`) times any
+    /// emission multiplier of the instance. A finite number >= 0.
+    pub power_scale: f32,
+}
+
+impl Instance {
+    /// `mesh` placed by `transform`, its powers scaled by the transform's
+    /// area scale, `|det|^(2/3)`: exact for rotations, uniform scales,
+    /// mirrors and translations; for a non-uniform scale the mean area
+    /// scale, a weight only (sampling stays exact and unbiased whatever the
+    /// powers; they steer it).
+    pub fn new(mesh: u32, transform: Affine3A) -> Self {
+        let side = cbrt(transform.matrix3.determinant().abs());
+        Self {
+            mesh,
+            transform,
+            power_scale: side * side,
+        }
+    }
+
+    /// This instance with its powers scaled by `factor` more (an emission
+    /// multiplier).
+    pub fn emitting(self, factor: f32) -> Self {
+        Self {
+            power_scale: self.power_scale * factor,
+            ..self
+        }
+    }
+}
+
+/// A placed instance as the hierarchy reads it.
+#[derive(Clone, Copy, Debug)]
+struct Placed {
+    mesh: u32,
+    transform: Affine3A,
+    /// `|M|`, the absolute linear part: a local box's half extent maps to
+    /// at most `|M| * extent`.
+    abs_linear: [Vec3A; 3],
+    power_scale: f32,
+    /// Whether the transform keeps angles (a rotation, mirror and uniform
+    /// scale), so a normal cone maps to a cone of the same angle; else
+    /// instance nodes are bounded by the whole sphere of directions.
+    similar: bool,
+    /// The sign of the transform's determinant: a mirror turns a
+    /// triangle's winding, and so the side it emits on.
+    handedness: f32,
+    /// The instance's first node past its root, and its first emitter.
+    node_base: u32,
+    emitter_base: u32,
+}
+
+/// A light tree over instances of emissive meshes: one [`LightTree`] per
+/// mesh, built once in mesh space and shared by every instance of it, and
+/// a top tree over the instances whose leaf for instance `i` continues
+/// into its mesh's tree, seen through the instance's transform. A scene of
+/// 8,000 instances of a 5,000-triangle mesh stores one 5,000-leaf tree and
+/// an 8,000-leaf one, not 40 million leaves (docs/benchmarks.md).
+///
+/// As a [`LightHierarchy`] it is the flat tree it stands for: emitter
+/// `emitter_base(i) + t` is triangle (emitter) `t` of instance `i`'s mesh
+/// ([`InstancedLightTree::emitter_id`], [`InstancedLightTree::locate`]), with
+/// world-space bounds, cones and powers computed on the fly from the
+/// mesh's; so every sampler over a hierarchy samples it exactly (sample ==
+/// pmf, normalised) and the GLT's cuts descend into the instances. Nodes
+/// `0..top` are the top tree's (instance `i`'s leaf is its mesh's root);
+/// instance `i`'s other nodes follow, in instance order. Queries inside an
+/// instance find it by binary search over the instances (O(log
+/// instances)).
+#[derive(Clone, Debug)]
+pub struct InstancedLightTree {
+    meshes: Vec<LightTree>,
+    instances: Vec<Placed>,
+    top: LightTree,
+    node_count: u32,
+    emitter_count: u32,
+}
+
+impl InstancedLightTree {
+    /// Builds the top tree over `instances` of `meshes` (trees built in
+    /// mesh space, any number of instances each) with `heuristic`.
+    ///
+    /// Errors: an instance naming no mesh, with a non-finite or singular
+    /// transform, or a power scale that is not a finite number >= 0
+    /// ([`BuildError::InvalidInstance`]); more nodes or emitters than `u32`
+    /// ids can name ([`BuildError::TooManyEmitters`]); and the top tree's
+    /// own errors.
+    pub fn build(
+        meshes: Vec<LightTree>,
+        instances: &[Instance],
+        heuristic: BuildHeuristic,
+    ) -> Result<Self, BuildError> {
+        let top_emitters = instances
+            .iter()
+            .enumerate()
+            .map(|(i, inst)| {
+                let invalid = BuildError::InvalidInstance { instance: i };
+                let mesh = meshes.get(inst.mesh as usize).ok_or(invalid)?;
+                let m = inst.transform.matrix3;
+                let det = m.determinant();
+                let fine = inst.transform.translation.is_finite()
+                    && m.is_finite()
+                    && det != 0.0
+                    && det.is_finite()
+                    && inst.power_scale.is_finite()
+                    && inst.power_scale >= 0.0;
+                if !fine {
+                    return Err(invalid);
+                }
+                Ok(Emitter {
+                    area: 0.0,
+                    delta: false,
+                    ..root_emitter(mesh, &place(inst, 0, 0))
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let top = LightTree::build(top_emitters.as_slice(), heuristic)?;
+        let too_many = |count| BuildError::TooManyEmitters { count };
+        let mut node_base = top.node_count() as u64;
+        let mut emitter_base = 0u64;
+        let mut placed = Vec::with_capacity(instances.len());
+        for inst in instances {
+            let mesh = &meshes[inst.mesh as usize];
+            let p = place(inst, node_base as u32, emitter_base as u32);
+            node_base += mesh.node_count().saturating_sub(1) as u64;
+            emitter_base += mesh.emitter_count() as u64;
+            if node_base > u64::from(u32::MAX) || emitter_base >= u64::from(u32::MAX) {
+                return Err(too_many(emitter_base as usize));
+            }
+            placed.push(p);
+        }
+        Ok(Self {
+            meshes,
+            instances: placed,
+            top,
+            node_count: node_base as u32,
+            emitter_count: emitter_base as u32,
+        })
+    }
+
+    /// The meshes' trees.
+    pub fn meshes(&self) -> &[LightTree] {
+        &self.meshes
+    }
+
+    /// The tree over the instances (its emitter `i` is instance `i`).
+    pub fn top(&self) -> &LightTree {
+        &self.top
+    }
+
+    /// The emitter id of emitter `t` of instance `instance`'s mesh; `None`
+    /// out of range.
+    pub fn emitter_id(&self, instance: u32, t: u32) -> Option<u32> {
+        let p = self.instances.get(instance as usize)?;
+        let mesh = &self.meshes[p.mesh as usize];
+        ((t as usize) < mesh.emitter_count()).then(|| p.emitter_base + t)
+    }
+
+    /// The instance and mesh emitter of emitter id `emitter`; `None` out
+    /// of range.
+    pub fn locate(&self, emitter: u32) -> Option<(u32, u32)> {
+        if emitter >= self.emitter_count {
+            return None;
+        }
+        // The last instance starting at or before it (instances of empty
+        // meshes start where the next one does: the last of them is taken,
+        // and that is the one holding it).
+        let i = self
+            .instances
+            .partition_point(|p| p.emitter_base <= emitter)
+            - 1;
+        Some((i as u32, emitter - self.instances[i].emitter_base))
+    }
+
+    /// Bytes held: the meshes' trees, the top tree and the instances.
+    pub fn bytes(&self) -> usize {
+        self.meshes.iter().map(LightTree::bytes).sum::<usize>()
+            + self.top.bytes()
+            + self.instances.len() * core::mem::size_of::<Placed>()
+    }
+
+    /// The instance (index and placement) and mesh node of node `node`
+    /// past the top tree.
+    #[inline]
+    fn inside(&self, node: u32) -> Option<(u32, &Placed, u32)> {
+        if node < self.top.node_count() as u32 || node >= self.node_count {
+            return None;
+        }
+        // The last instance starting at or before it (one whose mesh has
+        // no node past its root starts where the next one does).
+        let i = self.instances.partition_point(|p| p.node_base <= node) - 1;
+        let p = &self.instances[i];
+        Some((i as u32, p, node - p.node_base + 1))
+    }
+
+    /// The id of mesh node `local` of instance `i` (`p` its placement).
+    #[inline]
+    fn id(&self, i: u32, p: &Placed, local: u32) -> Option<u32> {
+        match local {
+            0 => self.top.leaf(i),
+            _ => Some(p.node_base + local - 1),
+        }
+    }
+}
+
+/// `inst` as the hierarchy reads it, its nodes from `node_base`, its
+/// emitters from `emitter_base`.
+fn place(inst: &Instance, node_base: u32, emitter_base: u32) -> Placed {
+    let m = inst.transform.matrix3;
+    let abs_linear = [m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs()];
+    let gram = m.transpose() * m;
+    let s2 = (gram.x_axis.x + gram.y_axis.y + gram.z_axis.z) / 3.0;
+    let tolerance = 1e-4 * s2;
+    let off = |a: f32, b: f32| (a - b).abs() <= tolerance;
+    let similar = off(gram.x_axis.x, s2)
+        && off(gram.y_axis.y, s2)
+        && off(gram.z_axis.z, s2)
+        && off(gram.x_axis.y, 0.0)
+        && off(gram.x_axis.z, 0.0)
+        && off(gram.y_axis.z, 0.0);
+    Placed {
+        mesh: inst.mesh,
+        transform: inst.transform,
+        abs_linear,
+        power_scale: inst.power_scale,
+        similar,
+        handedness: m.determinant().signum(),
+        node_base,
+        emitter_base,
+    }
+}
+
+/// Mesh-space bounds `b` seen through placement `p`: the box around the
+/// transformed box, the cone turned with it (the whole sphere when the
+/// transform does not keep angles), the power scaled.
+fn world(p: &Placed, b: NodeBounds) -> NodeBounds {
+    let c = Vec3A::from(b.bounds.center());
+    let h = Vec3A::from(b.bounds.diagonal()) * 0.5;
+    let [x, y, z] = p.abs_linear;
+    let extent = Vec3::from(x * h.x + y * h.y + z * h.z);
+    let center = Vec3::from(p.transform.transform_point3a(c));
+    let cone = if b.cone.cos_theta_o <= -1.0 {
+        b.cone
+    } else if p.similar {
+        let axis = p.transform.matrix3.mul_vec3a(Vec3A::from(b.cone.axis)) * p.handedness;
+        match Vec3::from(axis).try_normalize() {
+            Some(axis) => LightCone { axis, ..b.cone },
+            None => LightCone {
+                cos_theta_o: -1.0,
+                ..b.cone
+            },
+        }
+    } else {
+        LightCone {
+            cos_theta_o: -1.0,
+            ..b.cone
+        }
+    };
+    NodeBounds {
+        bounds: Aabb::new(center - extent, center + extent),
+        cone,
+        two_sided: b.two_sided,
+        power: b.power * p.power_scale,
+    }
+}
+
+/// The top tree's emitter for an instance: its mesh's root, placed.
+fn root_emitter(mesh: &LightTree, p: &Placed) -> Emitter {
+    let Some(root) = mesh.root() else {
+        // An empty mesh: nothing to choose, a point where it stands.
+        let at = Vec3::from(p.transform.translation);
+        return Emitter::point(at, 0.0);
+    };
+    let b = world(p, mesh.node_bounds(root));
+    Emitter {
+        bounds: b.bounds,
+        power: b.power,
+        area: 0.0,
+        cone: (b.cone.cos_theta_o > -1.0).then_some(b.cone),
+        two_sided: b.two_sided,
+        delta: false,
+        weight: 1.0,
+        light_sets: u64::MAX,
+    }
+}
+
+impl LightHierarchy for InstancedLightTree {
+    #[inline]
+    fn root(&self) -> Option<u32> {
+        self.top.root()
+    }
+
+    fn children(&self, node: u32) -> Option<[u32; 2]> {
+        if let Some((i, p, local)) = self.inside(node) {
+            let [a, b] = self.meshes[p.mesh as usize].children(local)?;
+            return Some([self.id(i, p, a)?, self.id(i, p, b)?]);
+        }
+        match self.top.children(node) {
+            Some(c) => Some(c),
+            None => {
+                let i = self.top.emitter(node)?;
+                let p = &self.instances[i as usize];
+                let [a, b] = self.meshes[p.mesh as usize].children(0)?;
+                Some([self.id(i, p, a)?, self.id(i, p, b)?])
+            }
+        }
+    }
+
+    fn parent(&self, node: u32) -> Option<u32> {
+        match self.inside(node) {
+            Some((i, p, local)) => {
+                let parent = self.meshes[p.mesh as usize].parent(local)?;
+                self.id(i, p, parent)
+            }
+            None => self.top.parent(node),
+        }
+    }
+
+    fn power(&self, node: u32) -> f32 {
+        match self.inside(node) {
+            Some((_, p, local)) => self.meshes[p.mesh as usize].power(local) * p.power_scale,
+            None => self.top.power(node),
+        }
+    }
+
+    fn node_bounds(&self, node: u32) -> NodeBounds {
+        match self.inside(node) {
+            Some((_, p, local)) => world(p, self.meshes[p.mesh as usize].node_bounds(local)),
+            None => self.top.node_bounds(node),
+        }
+    }
+
+    fn emitter(&self, node: u32) -> Option<u32> {
+        let (p, local) = match self.inside(node) {
+            Some((_, p, local)) => (p, local),
+            None if self.top.children(node).is_some() => return None,
+            None => (&self.instances[self.top.emitter(node)? as usize], 0),
+        };
+        let t = self.meshes[p.mesh as usize].emitter(local)?;
+        Some(p.emitter_base + t)
+    }
+
+    fn leaf(&self, emitter: u32) -> Option<u32> {
+        let (i, t) = self.locate(emitter)?;
+        let p = &self.instances[i as usize];
+        let local = self.meshes[p.mesh as usize].leaf(t)?;
+        self.id(i, p, local)
+    }
+
+    fn node_count(&self) -> usize {
+        self.node_count as usize
+    }
+
+    fn emitter_count(&self) -> usize {
+        self.emitter_count as usize
+    }
+}

@@ -1,0 +1,295 @@
+//! Instanced emissive meshes (`InstancedLightTree`): a hierarchy that
+//! stands for the flat tree of every instance's triangles in world space.
+//! Checked against that flat scene: the structure names every emitter once
+//! and its bounds contain the world-space triangles below; every tree
+//! sampler and the GLT sample it exactly (pmf sums to 1, sample == pmf bit
+//! for bit, chi-square) and without bias (every light that contributes has
+//! a positive pmf, so the estimate's expectation is the flat sum).
+
+use glam::{Affine3A, Quat, Vec3};
+use guiding::glt::{Glt, GltConfig};
+use guiding::light_sampler::{ImportanceTreeSampler, PowerTreeSampler};
+use guiding::light_tree::BuildHeuristic;
+use guiding::math::Aabb;
+use guiding::{
+    BuildError, Emitter, Instance, InstancedLightTree, LightHierarchy, LightId, LightSampler,
+    LightTree, ShadingContext,
+};
+
+mod common;
+use common::{LightsAt, Rand, chi_square_z, contribution};
+
+/// A triangle of a mesh: corners, power, two-sided.
+type Triangle = ([Vec3; 3], f32, bool);
+
+/// A mesh of `n` small triangles in the unit box around the origin (one-
+/// and two-sided, powers spread over two decades).
+fn mesh(n: usize, r: &mut Rand) -> Vec<Triangle> {
+    (0..n)
+        .map(|_| {
+            let c = r.point(1.0);
+            let p = [c, c + r.dir() * 0.1, c + r.dir() * 0.1];
+            (p, 10f32.powf(r.range(-1.0, 1.0)), r.f() < 0.3)
+        })
+        .collect()
+}
+
+fn emitters(triangles: &[Triangle], inst: &Instance) -> Vec<Emitter> {
+    triangles
+        .iter()
+        .map(|&(p, power, two_sided)| {
+            let p = p.map(|c| inst.transform.transform_point3(c));
+            Emitter::triangle(p, power * inst.power_scale, two_sided)
+        })
+        .collect()
+}
+
+struct Scene {
+    tree: InstancedLightTree,
+    /// The same lights flat in world space, in the instanced tree's
+    /// emitter order.
+    flat: Vec<Emitter>,
+}
+
+/// Three meshes (40 triangles, one triangle, none) in 12 instances:
+/// rotated and scaled, mirrored, stretched (a non-uniform scale), one
+/// emitting 5x.
+fn scene() -> Scene {
+    let mut r = Rand::new(71);
+    let meshes: Vec<Vec<Triangle>> = [40, 1, 0].map(|n| mesh(n, &mut r)).into();
+    let trees: Vec<LightTree> = meshes
+        .iter()
+        .map(|m| {
+            let local = emitters(m, &Instance::new(0, Affine3A::IDENTITY));
+            LightTree::build(local.as_slice(), BuildHeuristic::Sarh).unwrap()
+        })
+        .collect();
+    let mut instances = Vec::new();
+    for i in 0..12 {
+        let at = Vec3::new(
+            i as f32 * 7.0 - 40.0,
+            r.range(-5.0, 5.0),
+            r.range(-20.0, 20.0),
+        );
+        let turn = Quat::from_axis_angle(r.dir(), r.range(0.0, 6.0));
+        let transform = match i % 4 {
+            0 => Affine3A::from_scale_rotation_translation(Vec3::splat(3.0), turn, at),
+            1 => Affine3A::from_scale_rotation_translation(Vec3::new(-2.0, 2.0, 2.0), turn, at),
+            2 => Affine3A::from_scale_rotation_translation(Vec3::new(4.0, 1.0, 0.5), turn, at),
+            _ => Affine3A::from_rotation_translation(turn, at),
+        };
+        let mesh = match i {
+            5 => 1,
+            7 => 2,
+            _ => 0,
+        };
+        let inst = Instance::new(mesh, transform);
+        instances.push(if i == 3 { inst.emitting(5.0) } else { inst });
+    }
+    let tree = InstancedLightTree::build(trees, &instances, BuildHeuristic::Sarh).unwrap();
+    let flat = instances
+        .iter()
+        .flat_map(|inst| emitters(&meshes[inst.mesh as usize], inst))
+        .collect();
+    Scene { tree, flat }
+}
+
+#[test]
+fn it_names_every_emitter_once_and_bounds_what_is_below() {
+    let Scene { tree, flat } = scene();
+    assert_eq!(tree.emitter_count(), flat.len());
+    for (i, e) in flat.iter().enumerate() {
+        let e_id = i as u32;
+        let leaf = tree.leaf(e_id).unwrap();
+        assert_eq!(tree.emitter(leaf), Some(e_id));
+        assert_eq!(tree.children(leaf), None);
+        let (inst, t) = tree.locate(e_id).unwrap();
+        assert_eq!(tree.emitter_id(inst, t), Some(e_id));
+        // Every node on its path bounds it.
+        let mut node = Some(leaf);
+        while let Some(n) = node {
+            let b = tree.node_bounds(n);
+            let grown = Aabb::new(b.bounds.min - 1e-3, b.bounds.max + 1e-3);
+            assert!(
+                grown.contains(e.bounds.min) && grown.contains(e.bounds.max),
+                "node {n} does not bound emitter {i}"
+            );
+            node = tree.parent(n);
+        }
+    }
+    // Every node reached once from the root, powers adding up.
+    let mut seen = vec![false; tree.node_count()];
+    let mut stack = vec![tree.root().unwrap()];
+    let mut leaves = 0;
+    while let Some(n) = stack.pop() {
+        assert!(
+            !std::mem::replace(&mut seen[n as usize], true),
+            "node {n} twice"
+        );
+        match tree.children(n) {
+            Some([a, b]) => {
+                assert_eq!(tree.parent(a), Some(n));
+                assert_eq!(tree.parent(b), Some(n));
+                let sum = tree.power(a) + tree.power(b);
+                assert!(
+                    (tree.power(n) - sum).abs() <= 1e-3 * sum.max(1e-6),
+                    "node {n}"
+                );
+                stack.extend([a, b]);
+            }
+            None => leaves += 1,
+        }
+    }
+    assert!(seen.iter().all(|&s| s));
+    // The empty mesh's instance is a leaf with no emitter.
+    assert_eq!(leaves, flat.len() + 1);
+    assert_eq!(tree.locate(flat.len() as u32), None);
+    assert_eq!(tree.emitter_id(0, 40), None);
+}
+
+/// The contract of `s` at `ctx` over the flat lights: pmf sums to 1,
+/// draws report their pmf bit for bit, and no light that contributes has
+/// pmf 0 (so the estimate is unbiased: its expectation is the flat sum).
+fn check(name: &str, s: &dyn LightSampler, flat: &[Emitter], ctx: &ShadingContext, r: &mut Rand) {
+    let mut total = 0.0;
+    let mut expectation = 0.0;
+    let mut sum = 0.0;
+    for (i, e) in flat.iter().enumerate() {
+        let pmf = s.pmf_exact(ctx, LightId::Emitter(i as u32));
+        let f = contribution(e, ctx.position);
+        assert!(
+            f == 0.0 || pmf > 0.0,
+            "{name}: light {i} contributes with pmf 0"
+        );
+        if pmf > 0.0 {
+            expectation += pmf * (f / pmf);
+        }
+        sum += f;
+        total += pmf;
+    }
+    assert!((total - 1.0).abs() < 1e-6, "{name}: total {total}");
+    assert!((expectation - sum).abs() <= 1e-9 * sum, "{name}");
+    for _ in 0..40 {
+        let x = s.sample(ctx, r.f()).unwrap();
+        assert_eq!(x.pmf.to_bits(), s.pmf(ctx, x.light).to_bits(), "{name}");
+    }
+}
+
+#[test]
+fn every_tree_sampler_samples_it_exactly() {
+    let Scene { tree, flat } = scene();
+    let importance = ImportanceTreeSampler::new(&tree);
+    let power = PowerTreeSampler::new(&tree);
+    let mut r = Rand::new(72);
+    for _ in 0..30 {
+        let p = r.point(50.0);
+        for ctx in [
+            ShadingContext::at(p),
+            ShadingContext::on_surface(p, r.dir()),
+        ] {
+            check("importance", &importance, &flat, &ctx, &mut r);
+            check("power", &power, &flat, &ctx, &mut r);
+        }
+    }
+    // The power tree's pmf is each light's share of the power, as flat.
+    let total: f64 = flat.iter().map(|e| f64::from(e.power)).sum();
+    let ctx = ShadingContext::at(Vec3::ZERO);
+    for (i, e) in flat.iter().enumerate() {
+        let pmf = power.pmf_exact(&ctx, LightId::Emitter(i as u32));
+        let share = f64::from(e.power) / total;
+        assert!(
+            (pmf - share).abs() <= 1e-4 * share,
+            "light {i}: {pmf} vs {share}"
+        );
+    }
+}
+
+#[test]
+fn draws_follow_the_pmf() {
+    let Scene { tree, flat } = scene();
+    let s = ImportanceTreeSampler::new(&tree);
+    let ctx = ShadingContext::on_surface(Vec3::new(3.0, 1.0, -2.0), Vec3::Y);
+    let mut counts = vec![0u64; flat.len()];
+    let mut r = Rand::new(73);
+    for _ in 0..200_000 {
+        let LightId::Emitter(e) = s.sample(&ctx, r.f()).unwrap().light else {
+            panic!()
+        };
+        counts[e as usize] += 1;
+    }
+    let probs: Vec<f64> = (0..flat.len() as u32)
+        .map(|e| s.pmf_exact(&ctx, LightId::Emitter(e)))
+        .collect();
+    let (z, _) = chi_square_z(&counts, &probs).unwrap();
+    assert!(z < 4.0, "chi-square z {z}");
+}
+
+/// The GLT over instances: its cuts descend into the instances' subtrees,
+/// and it samples exactly, trained.
+#[test]
+fn the_glt_learns_inside_instances() {
+    let Scene { tree, flat } = scene();
+    let bounds = Aabb::new(Vec3::splat(-60.0), Vec3::splat(60.0));
+    let config = GltConfig {
+        spatial_threshold: 1e9,
+        ..GltConfig::default()
+    };
+    let mut glt = Glt::new(&tree, bounds, config).unwrap();
+    let mut r = Rand::new(74);
+    for _ in 0..4 {
+        for _ in 0..20_000 {
+            let p = r.point(50.0);
+            let e = r.below(flat.len() as u32);
+            let v = contribution(&flat[e as usize], p) as f32 * flat.len() as f32;
+            glt.record_light_at(p, LightId::Emitter(e), v);
+        }
+        glt.refine();
+    }
+    let top = tree.top().node_count() as u32;
+    let v = glt.light_at(Vec3::ZERO);
+    v.cut().check(&tree).unwrap();
+    let deepest = v.cut().clusters(&tree).iter().map(|c| c.0).max().unwrap();
+    assert!(
+        deepest >= top,
+        "the cut stays in the top tree ({deepest} < {top})"
+    );
+    for _ in 0..20 {
+        let p = r.point(50.0);
+        let v = glt.light_at(p);
+        check("glt", &v, &flat, &ShadingContext::at(p), &mut r);
+    }
+}
+
+#[test]
+fn bad_instances_are_typed_errors() {
+    let mut r = Rand::new(75);
+    let lights = emitters(&mesh(5, &mut r), &Instance::new(0, Affine3A::IDENTITY));
+    let meshes = || vec![LightTree::build(lights.as_slice(), BuildHeuristic::Sarh).unwrap()];
+    let ok = Instance::new(0, Affine3A::IDENTITY);
+    let cases = [
+        Instance { mesh: 1, ..ok },
+        Instance::new(0, Affine3A::from_scale(Vec3::new(1.0, 0.0, 1.0))),
+        Instance::new(0, Affine3A::from_translation(Vec3::NAN)),
+        Instance {
+            power_scale: -1.0,
+            ..ok
+        },
+        Instance {
+            power_scale: f32::INFINITY,
+            ..ok
+        },
+    ];
+    for bad in cases {
+        let got = InstancedLightTree::build(meshes(), &[ok, bad], BuildHeuristic::Sarh);
+        assert_eq!(
+            got.err(),
+            Some(BuildError::InvalidInstance { instance: 1 }),
+            "{bad:?}"
+        );
+    }
+    // No instance: an empty hierarchy that chooses nothing.
+    let empty = InstancedLightTree::build(meshes(), &[], BuildHeuristic::Sarh).unwrap();
+    assert_eq!(empty.root(), None);
+    let s = ImportanceTreeSampler::new(&empty);
+    assert!(s.sample(&ShadingContext::at(Vec3::ZERO), 0.5).is_none());
+}
