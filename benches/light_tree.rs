@@ -1,23 +1,27 @@
 //! Light tree build time per heuristic at 1e3..1e6 emitters, the time to
-//! refit a built tree to moved emitters, and the tree's memory (bytes per
-//! node and per emitter).
+//! refit a built tree to moved emitters, the tree's memory (bytes per node
+//! and per emitter), and instanced emissive meshes: 8,000 instances of a
+//! 5,000-triangle mesh built as an `InstancedLightTree` against the flat
+//! tree of their triangles (built whole at 50 and 200 instances; the 8,000
+//! figures scaled from them).
 //!
-//! `cargo bench --bench light_tree` runs everything (about 6 minutes on a
+//! `cargo bench --bench light_tree` runs everything (about 7 minutes on a
 //! quiet 2-core machine, most of it the 1e6 builds); pass a filter such as
-//! `-- build/Sarh` or `-- refit` to run less.
+//! `-- build/Sarh`, `-- refit` or `-- instanced` to run less.
 
 use criterion::measurement::WallTime;
 use criterion::{
     BenchmarkGroup, BenchmarkId, Criterion, SamplingMode, criterion_group, criterion_main,
 };
+use glam::{Affine3A, Quat, Vec3};
 use guiding::light_tree::BuildHeuristic;
-use guiding::{LightHierarchy, LightTree};
+use guiding::{Emitter, Instance, InstancedLightTree, LightHierarchy, LightTree};
 use std::hint::black_box;
 use std::time::Duration;
 
 #[path = "../tests/common/mod.rs"]
 mod common;
-use common::mixed_scene;
+use common::{Rand, mixed_scene};
 
 const HEURISTICS: [BuildHeuristic; 4] = [
     BuildHeuristic::Balanced,
@@ -106,5 +110,94 @@ fn refit(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, build, refit);
+/// A mesh of `n` small emissive triangles in the unit box.
+fn mesh(n: usize, r: &mut Rand) -> Vec<[Vec3; 3]> {
+    (0..n)
+        .map(|_| {
+            let c = r.point(1.0);
+            [c, c + r.dir() * 0.05, c + r.dir() * 0.05]
+        })
+        .collect()
+}
+
+/// `count` instances in a box 2,000 wide: turned, scaled 0.5-2x.
+fn instances(count: usize, r: &mut Rand) -> Vec<Instance> {
+    (0..count)
+        .map(|_| {
+            let turn = Quat::from_axis_angle(r.dir(), r.range(0.0, 6.0));
+            let t = Affine3A::from_scale_rotation_translation(
+                Vec3::splat(r.range(0.5, 2.0)),
+                turn,
+                r.point(1000.0),
+            );
+            Instance::new(0, t)
+        })
+        .collect()
+}
+
+fn instanced_tree(triangles: &[[Vec3; 3]], placed: &[Instance]) -> InstancedLightTree {
+    let local: Vec<Emitter> = triangles
+        .iter()
+        .map(|&p| Emitter::triangle(p, 1.0, false))
+        .collect();
+    let mesh = LightTree::build(local.as_slice(), BuildHeuristic::Sarh).expect("valid mesh");
+    InstancedLightTree::build(vec![mesh], placed, BuildHeuristic::Sarh).expect("valid instances")
+}
+
+fn flat(triangles: &[[Vec3; 3]], placed: &[Instance]) -> Vec<Emitter> {
+    placed
+        .iter()
+        .flat_map(|inst| {
+            triangles.iter().map(move |p| {
+                let p = p.map(|c| inst.transform.transform_point3(c));
+                Emitter::triangle(p, inst.power_scale, false)
+            })
+        })
+        .collect()
+}
+
+/// 8,000 instances of a 5,000-triangle mesh: the instanced build (the
+/// mesh's tree and the top tree) against the flat build at 50 and 200
+/// instances (the flat one at 8,000 would hold 40 million leaves).
+fn instanced(c: &mut Criterion) {
+    const TRIANGLES: usize = 5_000;
+    let mut r = Rand::new(9);
+    let triangles = mesh(TRIANGLES, &mut r);
+    let all = instances(8_000, &mut r);
+    let tree = instanced_tree(&triangles, &all);
+    println!("instanced emissive meshes ({TRIANGLES} triangles per mesh, SARH):");
+    println!(
+        "  instanced, 8000 instances: {} emitters, {} nodes as a hierarchy, {:.2} MiB",
+        tree.emitter_count(),
+        tree.node_count(),
+        tree.bytes() as f64 / (1 << 20) as f64
+    );
+    for count in [50, 200] {
+        let lights = flat(&triangles, &all[..count]);
+        let t = LightTree::build(lights.as_slice(), BuildHeuristic::Sarh).expect("valid scene");
+        let at_8000 = t.bytes() as f64 * 8000.0 / count as f64;
+        println!(
+            "  flat, {count} instances: {} emitters, {:.2} MiB; scaled to 8000: {:.0} MiB, {:.0}x the instanced",
+            lights.len(),
+            t.bytes() as f64 / (1 << 20) as f64,
+            at_8000 / (1 << 20) as f64,
+            at_8000 / tree.bytes() as f64
+        );
+    }
+    let mut group = group(c, "instanced");
+    group.bench_function(BenchmarkId::new("instanced", "8000x5000"), |b| {
+        b.iter(|| instanced_tree(black_box(&triangles), black_box(&all)))
+    });
+    for count in [50, 200] {
+        let lights = flat(&triangles, &all[..count]);
+        group.bench_with_input(
+            BenchmarkId::new("flat", format!("{count}x5000")),
+            &lights,
+            |b, l| b.iter(|| LightTree::build(black_box(l.as_slice()), BuildHeuristic::Sarh)),
+        );
+    }
+    group.finish();
+}
+
+criterion_group!(benches, build, refit, instanced);
 criterion_main!(benches);
