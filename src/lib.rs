@@ -64,6 +64,8 @@
 //! | the save format and its checks | `src/persist/`, `docs/format.md` |
 //! | light-tree build heuristics | `src/light_tree/build/heuristic.rs` (the binned split: `build/binned.rs`) |
 //! | refitting the light tree to lights that moved, and when to rebuild | `src/light_tree/build/refit.rs` |
+//! | instanced emissive meshes (`InstancedLightTree`) | `src/light_tree/instanced.rs` |
+//! | light linking in the GLT's walk (`Restriction`) | `src/cut/sampling.rs` |
 //! | the importance of a light cluster | `src/light_sampler/importance.rs` |
 //! | the same, from decoded nodes in `f32` (the GLT's importance rules) | `src/cut/importance_table.rs` |
 //! | the one-number descent | `src/math/descent.rs` |
@@ -97,6 +99,8 @@
 //! | an occluded sample, a light behind the surface, a BSDF that is zero (and the shadow ray skipped) | record 0 or nothing, never a shadow ray for the record's sake: a zero adds nothing to what is learned; it only counts as a sample for the split and refinement rules, which then follow where paths go rather than where light arrives |
 //! | when to call `refine` | after each of PPG's doubling iterations ([`Iterations`]); a renderer that renders each tile to completion, after every wave of tiles (as many as it has threads): a GLT cell refines once it holds 3/2 of its records before ([`Glt::refine`]) |
 //! | lights that moved or changed power since the last frame (same lights, same order) | [`LightTree::refit`] the guide's tree, then hand it over ([`Glt::set_light_tree`], [`GuidingField::set_light_tree`]): what was learned is kept and every cell refines on the new frame's records; when the refit's drift passes [`LightTree::REBUILD_RATIO`], build a new tree and guide instead. A saved guide loads over any refit of its tree (docs/format.md) |
+//! | an object lit by some lights only (light linking) | the emitters' sets ([`Emitter::in_light_sets`], [`Emitters::light_sets`], up to 64) and the point's ([`ShadingContext::lit_by`]); unbounded lights by a per-point mask ([`ShadingContext::lit_by_unbounded`]). Every sampler renormalises exactly over what the point is lit by; with a GLT, keep one per receiver set over the shared tree (measured better than one masked GLT, docs/experiments/light-sets.md) |
+//! | many instances of one emissive mesh | one [`LightTree`] per mesh in mesh space, the instances as [`Instance`]s, one [`InstancedLightTree`] (a [`LightHierarchy`] every sampler and the GLT take); emitter ids through [`InstancedLightTree::emitter_id`] and [`InstancedLightTree::locate`] |
 //! | the spatial threshold | [`GltConfig::default`]'s, measured for renderers (docs/experiments/tile-order.md) |
 //!
 //! ## Features
