@@ -17,7 +17,7 @@ use guiding::{
 };
 
 mod common;
-use common::{LightsAt, Rand, chi_square_z, contribution};
+use common::{LightsAt, Rand, contribution, emitter_draws};
 
 /// A triangle of a mesh: corners, power, two-sided.
 type Triangle = ([Vec3; 3], f32, bool);
@@ -209,18 +209,7 @@ fn draws_follow_the_pmf() {
     let Scene { tree, flat } = scene();
     let s = ImportanceTreeSampler::new(&tree);
     let ctx = ShadingContext::on_surface(Vec3::new(3.0, 1.0, -2.0), Vec3::Y);
-    let mut counts = vec![0u64; flat.len()];
-    let mut r = Rand::new(73);
-    for _ in 0..200_000 {
-        let LightId::Emitter(e) = s.sample(&ctx, r.f()).unwrap().light else {
-            panic!()
-        };
-        counts[e as usize] += 1;
-    }
-    let probs: Vec<f64> = (0..flat.len() as u32)
-        .map(|e| s.pmf_exact(&ctx, LightId::Emitter(e)))
-        .collect();
-    let (z, _) = chi_square_z(&counts, &probs).unwrap();
+    let (_, z) = emitter_draws(&s, &ctx, flat.len(), 200_000, &mut Rand::new(73));
     assert!(z < 4.0, "chi-square z {z}");
 }
 

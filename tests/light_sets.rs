@@ -12,7 +12,7 @@ use guiding::math::Aabb;
 use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
 
 mod common;
-use common::{LightsAt, Rand, chi_square_z, mixed_scene};
+use common::{LightsAt, Rand, emitter_draws, mixed_scene};
 
 /// 300 mixed lights: a quarter in set 0, a quarter in set 1, a quarter in
 /// both, a quarter in every set.
@@ -152,18 +152,7 @@ fn the_restricted_glt_draws_what_its_pmf_says() {
     let p = Vec3::new(5.0, -3.0, 12.0);
     let v = glt.light_at(p);
     let ctx = ShadingContext::at(p).lit_by(0b10);
-    let mut counts = vec![0u64; lights.len()];
-    let mut r = Rand::new(114);
-    for _ in 0..200_000 {
-        let LightId::Emitter(e) = v.sample(&ctx, r.f()).unwrap().light else {
-            panic!()
-        };
-        counts[e as usize] += 1;
-    }
-    let probs: Vec<f64> = (0..lights.len() as u32)
-        .map(|e| v.pmf_exact(&ctx, LightId::Emitter(e)))
-        .collect();
-    let (z, _) = chi_square_z(&counts, &probs).unwrap();
+    let (_, z) = emitter_draws(&v, &ctx, lights.len(), 200_000, &mut Rand::new(114));
     assert!(z < 4.0, "chi-square z {z}");
     let all = ShadingContext::at(p);
     let only_set_0 = (0..lights.len()).filter(|i| i % 4 == 0);

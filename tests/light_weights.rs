@@ -11,7 +11,7 @@ use guiding::{
 };
 
 mod common;
-use common::{Rand, chi_square_z, mixed_scene};
+use common::{Rand, emitter_draws, mixed_scene};
 
 /// 60 mixed lights with weights: every fifth 0, every seventh 3, one 0.25,
 /// the rest 1.
@@ -77,20 +77,7 @@ fn the_weighted_uniform_sampler_draws_what_its_pmf_says() {
     let lights = weighted_scene();
     let s = UniformSampler::weighted(lights.as_slice());
     let ctx = ShadingContext::at(Vec3::ZERO);
-    let mut counts = vec![0u64; lights.len()];
-    let mut r = Rand::new(92);
-    for _ in 0..200_000 {
-        let x = s.sample(&ctx, r.f()).unwrap();
-        let LightId::Emitter(e) = x.light else {
-            panic!()
-        };
-        assert_eq!(x.pmf, s.pmf(&ctx, x.light));
-        counts[e as usize] += 1;
-    }
-    let probs: Vec<f64> = (0..lights.len() as u32)
-        .map(|e| s.pmf_exact(&ctx, LightId::Emitter(e)))
-        .collect();
-    let (z, _) = chi_square_z(&counts, &probs).unwrap();
+    let (counts, z) = emitter_draws(&s, &ctx, lights.len(), 200_000, &mut Rand::new(92));
     assert!(z < 4.0, "chi-square z {z}");
     for (i, e) in lights.iter().enumerate() {
         if e.weight == 0.0 {

@@ -276,6 +276,34 @@ pub fn gamma_q(a: f64, x: f64) -> f64 {
 /// is a p-value below 1e-4.
 pub const Z_P_1E4: f64 = 3.719_016_5;
 
+/// Draws `draws` emitters from `s` at `ctx` (each draw reporting exactly
+/// its `pmf`), counts them over emitters `0..n`, and returns the counts
+/// and the chi-square z against `pmf_exact` (below 4 for a sampler that
+/// draws what it says).
+pub fn emitter_draws<S: guiding::LightSampler + ?Sized>(
+    s: &S,
+    ctx: &guiding::ShadingContext,
+    n: usize,
+    draws: usize,
+    r: &mut Rand,
+) -> (Vec<u64>, f64) {
+    use guiding::LightId;
+    let mut counts = vec![0u64; n];
+    for _ in 0..draws {
+        let x = s.sample(ctx, r.f()).expect("a light");
+        let LightId::Emitter(e) = x.light else {
+            panic!("{:?}", x.light)
+        };
+        assert_eq!(x.pmf.to_bits(), s.pmf(ctx, x.light).to_bits());
+        counts[e as usize] += 1;
+    }
+    let probs: Vec<f64> = (0..n as u32)
+        .map(|e| s.pmf_exact(ctx, LightId::Emitter(e)))
+        .collect();
+    let (z, _) = chi_square_z(&counts, &probs).expect("no draw of pmf 0");
+    (counts, z)
+}
+
 /// Wilson–Hilferty z-score of `observed` counts against probabilities
 /// `probs`, pooling bins expected below 5; `None` when a light with pmf 0
 /// was drawn. Returns (z, degrees of freedom).
