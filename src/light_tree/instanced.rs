@@ -98,6 +98,11 @@ pub struct InstancedLightTree {
     top: LightTree,
     node_count: u32,
     emitter_count: u32,
+    /// The instance holding the first node of each run of `1 << shift`
+    /// nodes past the top tree: a node's instance is found from there in
+    /// a step or two instead of a binary search.
+    buckets: Vec<u32>,
+    shift: u32,
 }
 
 impl InstancedLightTree {
@@ -153,12 +158,16 @@ impl InstancedLightTree {
             }
             placed.push(p);
         }
+        let first = top.node_count() as u32;
+        let (buckets, shift) = buckets(&placed, first, node_base as u32);
         Ok(Self {
             meshes,
             instances: placed,
             top,
             node_count: node_base as u32,
             emitter_count: emitter_base as u32,
+            buckets,
+            shift,
         })
     }
 
@@ -201,6 +210,7 @@ impl InstancedLightTree {
         self.meshes.iter().map(LightTree::bytes).sum::<usize>()
             + self.top.bytes()
             + self.instances.len() * core::mem::size_of::<Placed>()
+            + self.buckets.len() * core::mem::size_of::<u32>()
     }
 
     /// The instance (index and placement) and mesh node of node `node`
@@ -211,8 +221,13 @@ impl InstancedLightTree {
             return None;
         }
         // The last instance starting at or before it (one whose mesh has
-        // no node past its root starts where the next one does).
-        let i = self.instances.partition_point(|p| p.node_base <= node) - 1;
+        // no node past its root starts where the next one does), walked to
+        // from its bucket's first.
+        let offset = node - self.top.node_count() as u32;
+        let mut i = self.buckets[(offset >> self.shift) as usize] as usize;
+        while self.instances.get(i + 1).is_some_and(|p| p.node_base <= node) {
+            i += 1;
+        }
         let p = &self.instances[i];
         Some((i as u32, p, node - p.node_base + 1))
     }
@@ -225,6 +240,25 @@ impl InstancedLightTree {
             _ => Some(p.node_base + local - 1),
         }
     }
+}
+
+/// The bucket index over the nodes `first..end` of `placed`: runs of
+/// `1 << shift` nodes, about one instance's worth each, and for each run
+/// the instance holding its first node.
+fn buckets(placed: &[Placed], first: u32, end: u32) -> (Vec<u32>, u32) {
+    let nodes = end - first;
+    let per_instance = nodes / (placed.len() as u32).max(1);
+    let shift = per_instance.max(1).ilog2();
+    let mut out = Vec::with_capacity((nodes >> shift) as usize + 1);
+    let mut i = 0usize;
+    for b in 0..=(nodes >> shift) {
+        let node = first + (b << shift);
+        while placed.get(i + 1).is_some_and(|p| p.node_base <= node) {
+            i += 1;
+        }
+        out.push(i as u32);
+    }
+    (out, shift)
 }
 
 /// `inst` as the hierarchy reads it, its nodes from `node_base`, its
