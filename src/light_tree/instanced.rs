@@ -225,7 +225,11 @@ impl InstancedLightTree {
         // from its bucket's first.
         let offset = node - self.top.node_count() as u32;
         let mut i = self.buckets[(offset >> self.shift) as usize] as usize;
-        while self.instances.get(i + 1).is_some_and(|p| p.node_base <= node) {
+        while self
+            .instances
+            .get(i + 1)
+            .is_some_and(|p| p.node_base <= node)
+        {
             i += 1;
         }
         let p = &self.instances[i];
