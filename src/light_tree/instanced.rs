@@ -91,6 +91,36 @@ struct Placed {
 /// instance `i`'s other nodes follow, in instance order. Queries inside an
 /// instance find it by binary search over the instances (O(log
 /// instances)).
+///
+/// ```
+/// use guiding::glam::{Affine3A, Vec3};
+/// use guiding::{Aabb, BuildHeuristic, Emitter, Glt, GltConfig, Instance, InstancedLightTree};
+/// use guiding::{LightHierarchy, LightSampler, LightTree, ShadingContext};
+/// // A lamp shade of two triangles, built once in its own space.
+/// let shade = [
+///     Emitter::triangle([Vec3::ZERO, Vec3::X, Vec3::Y], 1.0, false),
+///     Emitter::triangle([Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y], 1.0, false),
+/// ];
+/// let mesh = LightTree::build(&shade[..], BuildHeuristic::default())?;
+/// // Three lamps along a street, the last one twice as bright.
+/// let lamps: Vec<Instance> = (0..3)
+///     .map(|i| Instance::new(0, Affine3A::from_translation(Vec3::X * 10.0 * i as f32)))
+///     .collect();
+/// let lamps = [lamps[0], lamps[1], lamps[2].emitting(2.0)];
+/// let tree = InstancedLightTree::build(vec![mesh], &lamps, BuildHeuristic::default())?;
+/// assert_eq!(tree.emitter_count(), 6);
+/// // Emitter ids name (instance, triangle) pairs.
+/// let id = tree.emitter_id(2, 1).unwrap();
+/// assert_eq!(tree.locate(id), Some((2, 1)));
+/// // The GLT guides over it as over any hierarchy.
+/// let street = Aabb::new(Vec3::splat(-5.0), Vec3::new(30.0, 5.0, 5.0));
+/// let glt = Glt::new(&tree, street, GltConfig::default()).unwrap();
+/// let ctx = ShadingContext::on_surface(Vec3::new(20.5, 0.5, 3.0), -Vec3::Z);
+/// let vertex = glt.vertex(&ctx).unwrap();
+/// let s = vertex.sample(&ctx, 0.3).unwrap();
+/// assert_eq!(s.pmf, vertex.pmf(&ctx, s.light));
+/// # Ok::<(), guiding::BuildError>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct InstancedLightTree {
     meshes: Vec<LightTree>,
