@@ -80,6 +80,19 @@ impl ShadingContext {
     /// This context lit only by the unbounded lights in `lights` (bit `i`:
     /// [`LightId::Unbounded`](crate::LightId::Unbounded)`(i)`), its
     /// emitters unchanged: a sun linked away from an object.
+    ///
+    /// ```
+    /// use guiding::{glam::Vec3, Aabb, Emitter, LightId, LightSampler, ShadingContext};
+    /// use guiding::{Strategy, UnboundedLights};
+    /// let lamp = [Emitter::point(Vec3::ZERO, 1.0)];
+    /// let sun = UnboundedLights::new(1, 0.5)?;
+    /// let scene = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
+    /// let sampler = Strategy::new("power", &lamp[..], sun, scene).unwrap();
+    /// let indoors = ShadingContext::at(Vec3::Y).lit_by_unbounded(0);
+    /// assert_eq!(sampler.pmf(&indoors, LightId::Unbounded(0)), 0.0);
+    /// assert_eq!(sampler.pmf(&indoors, LightId::Emitter(0)), 1.0);
+    /// # Ok::<(), guiding::ConfigError>(())
+    /// ```
     pub fn lit_by_unbounded(self, lights: u64) -> Self {
         Self {
             receives_unbounded: lights,
