@@ -305,3 +305,42 @@ fn a_point_lit_by_no_set_is_lit_by_no_emitter() {
         }
     }
 }
+
+/// A renderer's own emitter list that says nothing of light sets puts
+/// every emitter in every set: its tree keeps no sets, and a point lit by
+/// any set is lit by every emitter, as a point lit by all.
+#[test]
+fn emitters_that_name_no_set_are_in_every_set() {
+    struct Plain(Vec<Emitter>);
+    impl guiding::Emitters for Plain {
+        fn len(&self) -> usize {
+            self.0.len()
+        }
+        fn bounds(&self, i: usize) -> Aabb {
+            self.0[i].bounds
+        }
+        fn power(&self, i: usize) -> f32 {
+            self.0[i].power
+        }
+        fn area(&self, i: usize) -> f32 {
+            self.0[i].area
+        }
+        fn cone(&self, i: usize) -> Option<guiding::math::LightCone> {
+            self.0[i].cone
+        }
+    }
+    let plain = Plain(mixed_scene(200, 120));
+    let tree = LightTree::build(&plain, BuildHeuristic::Sarh).unwrap();
+    assert!(!guiding::LightHierarchy::has_light_sets(&tree));
+    let s = ImportanceTreeSampler::new(&tree);
+    let mut r = Rand::new(121);
+    for _ in 0..10 {
+        let p = r.point(50.0);
+        let (all, one) = (ShadingContext::at(p), ShadingContext::at(p).lit_by(0b100));
+        for e in 0..200 {
+            let id = LightId::Emitter(e);
+            assert_eq!(s.pmf(&one, id).to_bits(), s.pmf(&all, id).to_bits());
+        }
+        check("plain emitters", &s, &plain.0, &one, &mut r);
+    }
+}
