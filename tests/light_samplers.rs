@@ -12,7 +12,7 @@ use guiding::light_sampler::{
 };
 use guiding::light_tree::{BuildHeuristic, LightHierarchy, NodeBounds};
 use guiding::math::{Aabb, LightCone};
-use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
+use guiding::{Emitter, LightId, LightSample, LightSampler, LightTree, ShadingContext};
 use proptest::prelude::*;
 use rand_pcg::Pcg64;
 use rand_pcg::rand_core::{Rng, SeedableRng};
@@ -1307,4 +1307,46 @@ fn one_million_emitters() {
             .sum();
         assert!((sum - 1.0).abs() < 1e-5, "{name}: {sum}");
     }
+}
+
+/// A renderer's own sampler that knows nothing of light linking: empty
+/// when it holds no light.
+struct Own(Option<LightSample>);
+
+impl LightSampler for Own {
+    fn sample(&self, ctx: &ShadingContext, _: f32) -> Option<LightSample> {
+        self.0.filter(|_| ctx.is_finite())
+    }
+    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
+        match self.0 {
+            Some(s) if s.light == light && ctx.is_finite() => s.pmf,
+            _ => 0.0,
+        }
+    }
+    fn is_empty(&self) -> bool {
+        self.0.is_none()
+    }
+}
+
+/// `is_empty_at`'s default answers `is_empty` at every finite point and
+/// true elsewhere, so `WithUnbounded` around a sampler of the renderer's
+/// own gives the sun everything when that sampler is empty, and shares
+/// as set when it is not.
+#[test]
+fn is_empty_at_defaults_to_is_empty_at_finite_points() {
+    let lamp = Some(LightSample {
+        light: LightId::Emitter(0),
+        pmf: 1.0,
+    });
+    let here = ShadingContext::at(Vec3::ONE);
+    let nowhere = ShadingContext::at(Vec3::NAN);
+    assert!(Own(None).is_empty_at(&here));
+    assert!(!Own(lamp).is_empty_at(&here));
+    assert!(Own(lamp).is_empty_at(&nowhere));
+    let sun = UnboundedLights::new(1, 0.3).unwrap();
+    let dark = WithUnbounded::new(Own(None), sun).unwrap();
+    assert_eq!(dark.pmf(&here, LightId::Unbounded(0)), 1.0);
+    let lit = WithUnbounded::new(Own(lamp), sun).unwrap();
+    assert_eq!(lit.pmf(&here, LightId::Unbounded(0)), 0.3);
+    assert_eq!(lit.pmf(&here, LightId::Emitter(0)), 0.7);
 }
