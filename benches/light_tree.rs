@@ -3,7 +3,10 @@
 //! and per emitter), and instanced emissive meshes: 8,000 instances of a
 //! 5,000-triangle mesh built as an `InstancedLightTree` against the flat
 //! tree of their triangles (built whole at 50 and 200 instances; the 8,000
-//! figures scaled from them).
+//! figures scaled from them), and the GLT over it: its tables per mesh
+//! against tables over every node (`Flattened`), built at 50 and 200
+//! instances and scaled likewise; and what a query costs over instances
+//! (`-- instanced-query`).
 //!
 //! `cargo bench --bench light_tree` runs everything (about 7 minutes on a
 //! quiet 2-core machine, most of it the 1e6 builds); pass a filter such as
@@ -14,14 +17,20 @@ use criterion::{
     BenchmarkGroup, BenchmarkId, Criterion, SamplingMode, criterion_group, criterion_main,
 };
 use glam::{Affine3A, Quat, Vec3};
+use guiding::glt::{Glt, GltConfig};
+use guiding::light_sampler::ImportanceTreeSampler;
 use guiding::light_tree::BuildHeuristic;
-use guiding::{Emitter, Instance, InstancedLightTree, LightHierarchy, LightTree};
+use guiding::math::Aabb;
+use guiding::{
+    Emitter, Instance, InstancedLightTree, LightHierarchy, LightId, LightSampler, LightTree,
+    ShadingContext,
+};
 use std::hint::black_box;
 use std::time::Duration;
 
 #[path = "../tests/common/mod.rs"]
 mod common;
-use common::{Rand, mixed_scene};
+use common::{Flattened, Rand, contribution, mixed_scene};
 
 const HEURISTICS: [BuildHeuristic; 4] = [
     BuildHeuristic::Balanced,
@@ -184,10 +193,43 @@ fn instanced(c: &mut Criterion) {
             at_8000 / tree.bytes() as f64
         );
     }
+    // The GLT over them: its tables per mesh, against tables over every
+    // node of the flat tree the instances stand for (`Flattened`).
+    let scene = Aabb::new(Vec3::splat(-1100.0), Vec3::splat(1100.0));
+    let glt = Glt::new(&tree, scene, GltConfig::default()).expect("valid configuration");
+    println!(
+        "  GLT over the instanced tree, 8000 instances: tables {:.2} MiB, total {:.2} MiB",
+        glt.memory().shared_bytes as f64 / (1 << 20) as f64,
+        glt.memory().total() as f64 / (1 << 20) as f64
+    );
+    let small: Vec<InstancedLightTree> = [50, 200]
+        .map(|count| instanced_tree(&triangles, &all[..count]))
+        .into();
+    for t in &small {
+        let count = t.top().emitter_count();
+        let g = Glt::new(Flattened(t), scene, GltConfig::default()).expect("valid configuration");
+        let at_8000 = g.memory().shared_bytes as f64 * 8000.0 / count as f64;
+        println!(
+            "  GLT with tables over every node, {count} instances: tables {:.2} MiB; scaled to 8000: {:.0} MiB, {:.0}x the per-mesh tables",
+            g.memory().shared_bytes as f64 / (1 << 20) as f64,
+            at_8000 / (1 << 20) as f64,
+            at_8000 / glt.memory().shared_bytes as f64
+        );
+    }
     let mut group = group(c, "instanced");
     group.bench_function(BenchmarkId::new("instanced", "8000x5000"), |b| {
         b.iter(|| instanced_tree(black_box(&triangles), black_box(&all)))
     });
+    group.bench_function(BenchmarkId::new("glt", "8000x5000"), |b| {
+        b.iter(|| Glt::new(black_box(&tree), scene, GltConfig::default()))
+    });
+    for t in &small {
+        let count = t.top().emitter_count();
+        group.bench_function(
+            BenchmarkId::new("glt-every-node", format!("{count}x5000")),
+            |b| b.iter(|| Glt::new(Flattened(black_box(t)), scene, GltConfig::default())),
+        );
+    }
     for count in [50, 200] {
         let lights = flat(&triangles, &all[..count]);
         group.bench_with_input(
@@ -199,5 +241,109 @@ fn instanced(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, build, refit, instanced);
+/// A GLT over `tree` trained as a renderer trains it, without shadows: 3
+/// rounds of 20,000 records, each the contribution of a light the GLT
+/// chooses at a random point on a random surface, over its pmf.
+fn trained<H: LightHierarchy>(tree: H, lights: &[Emitter], scene: Aabb) -> Glt<H> {
+    let mut glt = Glt::new(tree, scene, GltConfig::default()).expect("valid configuration");
+    let mut r = Rand::new(10);
+    for _ in 0..3 {
+        for _ in 0..20_000 {
+            // A renderer's record: a light chosen by the guide itself at a
+            // point on a surface, its unshadowed contribution over its pmf.
+            let ctx = ShadingContext::on_surface(r.point(scene.max.x - 2.0), r.dir());
+            let Some(vertex) = glt.vertex(&ctx) else {
+                continue;
+            };
+            if let Some(s) = vertex.sample(&ctx, r.f()) {
+                let LightId::Emitter(e) = s.light else {
+                    continue;
+                };
+                let v = contribution(&lights[e as usize], ctx.position) / f64::from(s.pmf);
+                vertex.record_light(s.light, v as f32);
+            }
+        }
+        glt.refine();
+    }
+    glt
+}
+
+/// A query over 200 instances of a 500-triangle mesh (turned, scaled
+/// 0.5-2x, in a box 100 wide): importance sampling over the flat tree and
+/// the instanced one, and the GLT over the flat tree, over the instanced
+/// one with tables over every node (`Flattened`), and with its tables per
+/// mesh; one sample and its pmf at a random point on a random surface.
+fn instanced_queries(c: &mut Criterion) {
+    let mut r = Rand::new(3);
+    let triangles: Vec<[Vec3; 3]> = (0..500)
+        .map(|_| {
+            let c = r.point(1.0);
+            [c, c + r.dir() * 0.05, c + r.dir() * 0.05]
+        })
+        .collect();
+    let placed: Vec<Instance> = (0..200)
+        .map(|_| {
+            let turn = Quat::from_axis_angle(r.dir(), r.range(0.0, 6.0));
+            let scale = Vec3::splat(r.range(0.5, 2.0));
+            Instance::new(
+                0,
+                Affine3A::from_scale_rotation_translation(scale, turn, r.point(50.0)),
+            )
+        })
+        .collect();
+    let tree = instanced_tree(&triangles, &placed);
+    let lights = flat(&triangles, &placed);
+    let flat_tree = LightTree::build(lights.as_slice(), BuildHeuristic::Sarh).expect("valid scene");
+    let scene = Aabb::new(Vec3::splat(-52.0), Vec3::splat(52.0));
+    let queries: Vec<(ShadingContext, f32)> = (0..1000)
+        .map(|_| (ShadingContext::on_surface(r.point(50.0), r.dir()), r.f()))
+        .collect();
+    let mut group = c.benchmark_group("instanced-query");
+    let per_query = |s: &dyn LightSampler, ctx: &ShadingContext, u: f32| {
+        s.sample(ctx, u)
+            .map_or(0.0, |x| x.pmf + s.pmf(ctx, x.light))
+    };
+    for (name, s) in [
+        (
+            "bvh-flat",
+            &ImportanceTreeSampler::new(&flat_tree) as &dyn LightSampler,
+        ),
+        ("bvh-instanced", &ImportanceTreeSampler::new(&tree)),
+    ] {
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                queries
+                    .iter()
+                    .map(|(ctx, u)| per_query(s, ctx, *u))
+                    .sum::<f32>()
+            })
+        });
+    }
+    fn glt_queries<H: LightHierarchy>(glt: &Glt<H>, queries: &[(ShadingContext, f32)]) -> f32 {
+        queries
+            .iter()
+            .map(|(ctx, u)| {
+                glt.vertex(ctx).map_or(0.0, |v| {
+                    v.sample(ctx, *u)
+                        .map_or(0.0, |x| x.pmf + v.pmf(ctx, x.light))
+                })
+            })
+            .sum()
+    }
+    let (a, b, c) = (
+        trained(&flat_tree, &lights, scene),
+        trained(Flattened(&tree), &lights, scene),
+        trained(&tree, &lights, scene),
+    );
+    group.bench_function("glt-flat", |bench| bench.iter(|| glt_queries(&a, &queries)));
+    group.bench_function("glt-every-node", |bench| {
+        bench.iter(|| glt_queries(&b, &queries))
+    });
+    group.bench_function("glt-per-mesh", |bench| {
+        bench.iter(|| glt_queries(&c, &queries))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, build, refit, instanced, instanced_queries);
 criterion_main!(benches);

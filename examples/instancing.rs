@@ -1,22 +1,28 @@
 //! What an instanced light tree costs in light choice: the light BVH's
-//! importance sampling (pbrt-v4's sampler, the GLT's prior) over an
-//! `InstancedLightTree` against the same lights in one flat tree, by the
-//! exact relative variance per sample at fixed points (every light's pmf
-//! against its unshadowed contribution; a clairvoyant pmf has 0).
+//! importance sampling (pbrt-v4's sampler, the GLT's prior) and the GLT,
+//! trained the same way, over an `InstancedLightTree` against the same
+//! lights in one flat tree, by the exact relative variance per sample at
+//! fixed points (every light's pmf against its unshadowed contribution; a
+//! clairvoyant pmf has 0).
 //!
 //! The top tree clusters whole instances, whose boxes overlap where
 //! instances crowd; the flat tree clusters triangles across instances. The
-//! build time and memory are in `benches/light_tree.rs` (`-- instanced`).
+//! GLT over the instanced tree reads its tables per mesh, the point moved
+//! into mesh space inside an instance. The build time and memory are in
+//! `benches/light_tree.rs` (`-- instanced`).
 //!
 //! ```text
 //! cargo run --release --example instancing
 //! ```
 
 use glam::{Affine3A, Quat, Vec3};
+use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::ImportanceTreeSampler;
 use guiding::light_tree::BuildHeuristic;
+use guiding::math::Aabb;
 use guiding::{
-    Emitter, Instance, InstancedLightTree, LightId, LightSampler, LightTree, ShadingContext,
+    Emitter, Instance, InstancedLightTree, LightHierarchy, LightId, LightSampler, LightTree,
+    ShadingContext,
 };
 use rayon::prelude::*;
 
@@ -52,14 +58,58 @@ fn variance(s: &dyn LightSampler, lights: &[Emitter], ctx: &ShadingContext) -> f
     second - 1.0
 }
 
+/// A GLT over `tree` trained as a renderer trains it, without shadows: 4
+/// rounds of 50,000 records, each the contribution of a light the GLT
+/// chooses at a random point on a random surface, over its pmf.
+fn trained<H: LightHierarchy>(tree: H, lights: &[Emitter], spread: f32) -> Glt<H> {
+    let scene = Aabb::new(Vec3::splat(-spread - 2.0), Vec3::splat(spread + 2.0));
+    let mut glt = Glt::new(tree, scene, GltConfig::default()).unwrap();
+    let mut r = Rand::new(11);
+    for _ in 0..4 {
+        for _ in 0..50_000 {
+            // A renderer's record: a light chosen by the guide itself at a
+            // point on a surface, its unshadowed contribution over its pmf.
+            let ctx = ShadingContext::on_surface(r.point(spread), r.dir());
+            let Some(vertex) = glt.vertex(&ctx) else {
+                continue;
+            };
+            if let Some(s) = vertex.sample(&ctx, r.f()) {
+                let LightId::Emitter(e) = s.light else {
+                    continue;
+                };
+                let v = contribution(&lights[e as usize], ctx.position) / f64::from(s.pmf);
+                vertex.record_light(s.light, v as f32);
+            }
+        }
+        glt.refine();
+    }
+    glt
+}
+
+/// The mean and the geometric mean of per-point ratios of two variances
+/// per point (points where either is 0 left out of the ratio).
+fn summary(v: &[(f64, f64)]) -> (f64, f64, f64) {
+    let n = v.len() as f64;
+    let kept: Vec<&(f64, f64)> = v.iter().filter(|x| x.0 > 0.0 && x.1 > 0.0).collect();
+    let ratio = kept.iter().map(|x| (x.1 / x.0).ln()).sum::<f64>() / kept.len() as f64;
+    (
+        v.iter().map(|x| x.0).sum::<f64>() / n,
+        v.iter().map(|x| x.1).sum::<f64>() / n,
+        ratio.exp(),
+    )
+}
+
 fn main() {
     println!(
-        "Importance sampling over an instanced light tree vs the flat tree of the same \
-         triangles: exact relative variance per sample, mean over {POINTS} points on random \
-         surfaces in the scene (instanced / flat: geometric mean of per-point ratios)\n"
+        "Light choice over an instanced light tree vs the flat tree of the same triangles: \
+         exact relative variance per sample, mean over {POINTS} points on random surfaces in \
+         the scene (instanced / flat: geometric mean of per-point ratios); the light BVH's \
+         importance sampling, then the GLT trained alike\n"
     );
-    println!("| instances | triangles each | spread | flat | instanced | instanced / flat |");
-    println!("| ---: | ---: | ---: | ---: | ---: | ---: |");
+    println!(
+        "| instances | triangles each | spread | BVH flat | BVH instanced | instanced / flat | GLT flat | GLT instanced | instanced / flat |"
+    );
+    println!("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
     for (count, triangles, spread) in [(200, 500, 50.0), (200, 500, 200.0), (1000, 100, 50.0)] {
         let mut r = Rand::new(3);
         let mesh: Vec<[Vec3; 3]> = (0..triangles)
@@ -104,14 +154,23 @@ fn main() {
             .par_iter()
             .map(|ctx| (variance(&a, &flat, ctx), variance(&b, &flat, ctx)))
             .collect();
-        let n = POINTS as f64;
-        let kept: Vec<&(f64, f64)> = v.iter().filter(|x| x.0 > 0.0 && x.1 > 0.0).collect();
-        let ratio = kept.iter().map(|x| (x.1 / x.0).ln()).sum::<f64>() / kept.len() as f64;
+        let (glt_flat, glt_instanced) = (
+            trained(&flat_tree, &flat, spread),
+            trained(&instanced, &flat, spread),
+        );
+        let g: Vec<(f64, f64)> = points
+            .par_iter()
+            .map(|ctx| {
+                let (Some(a), Some(b)) = (glt_flat.vertex(ctx), glt_instanced.vertex(ctx)) else {
+                    return (0.0, 0.0);
+                };
+                (variance(&a, &flat, ctx), variance(&b, &flat, ctx))
+            })
+            .collect();
+        let (bf, bi, br) = summary(&v);
+        let (gf, gi, gr) = summary(&g);
         println!(
-            "| {count} | {triangles} | {spread} | {:.3} | {:.3} | {:.2} |",
-            v.iter().map(|x| x.0).sum::<f64>() / n,
-            v.iter().map(|x| x.1).sum::<f64>() / n,
-            ratio.exp()
+            "| {count} | {triangles} | {spread} | {bf:.3} | {bi:.3} | {br:.2} | {gf:.3} | {gi:.3} | {gr:.2} |"
         );
     }
 }

@@ -65,6 +65,7 @@
 //! | light-tree build heuristics | `src/light_tree/build/heuristic.rs` (the binned split: `build/binned.rs`) |
 //! | refitting the light tree to lights that moved, and when to rebuild | `src/light_tree/build/refit.rs` |
 //! | instanced emissive meshes (`InstancedLightTree`) | `src/light_tree/instanced.rs` |
+//! | the GLT's tables over instances, one set per mesh; the walk into an instance | `src/cut/instanced_tables.rs`, `src/cut/tables.rs` |
 //! | light linking in the GLT's walk (`Restriction`) | `src/cut/sampling.rs` |
 //! | the importance of a light cluster | `src/light_sampler/importance.rs` |
 //! | the same, from decoded nodes in `f32` (the GLT's importance rules) | `src/cut/importance_table.rs` |

@@ -3,12 +3,13 @@
 
 use super::config::CutConfig;
 use super::guiding_cut::GuidingCut;
-use super::importance_table::ImportanceTable;
-use super::walk::WalkTable;
+use super::importance_table::FastQuery;
+use super::instanced_tables::InstancedTables;
+use super::tables::{Segment, TreeTables};
+use super::walk::WalkNode;
 use crate::error::ConfigError;
-use crate::light_tree::{LightHierarchy, same_shape};
+use crate::light_tree::{InstancedLightTree, LightHierarchy, same_shape};
 use crate::math::Descent;
-use alloc::vec::Vec;
 
 /// The rules every cell's cut is sampled, splatted and refined by, with the
 /// light-tree tables they read: the hierarchy, each inner node's power
@@ -17,7 +18,9 @@ use alloc::vec::Vec;
 /// table when a rule uses importance (32 bytes per node), and the cut
 /// configuration. One per scene; every cell's [`GuidingCut`] is sampled
 /// ([`CutRules::sample`]), splatted ([`CutRules::splat`]) and refined
-/// ([`CutRules::refine`]) through it.
+/// ([`CutRules::refine`]) through it. Over an
+/// [`InstancedLightTree`] the tables are its top tree's and one set per
+/// mesh, shared by the mesh's instances (`src/cut/instanced_tables.rs`).
 ///
 /// The split table is why the GLT's walk is cheaper per level than a plain
 /// power descent: the prior probabilities of a node's children come from
@@ -32,21 +35,18 @@ use alloc::vec::Vec;
 #[derive(Clone, Debug)]
 pub struct CutRules<H: LightHierarchy> {
     tree: H,
-    split: Vec<f32>,
-    walk: WalkTable,
-    /// Every node decoded for the importance-based rules; built only when
-    /// the configuration uses one.
-    importance: Option<ImportanceTable>,
+    /// The tables of the hierarchy, or of the top tree of an instanced
+    /// one.
+    tables: TreeTables,
+    /// An instanced hierarchy's per-mesh tables
+    /// ([`LightHierarchy::as_instanced`]).
+    instanced: Option<InstancedTables>,
     config: CutConfig,
     has_power: bool,
-    /// The light sets of both children of each walk-table pair (the
-    /// root's pair: the root's, twice); empty when the tree has no light
-    /// sets.
-    pair_sets: Vec<[u64; 2]>,
 }
 
 /// Encodes the split of a node with child powers `el`, `er`.
-fn encode_split(el: f32, er: f32) -> f32 {
+pub(crate) fn encode_split(el: f32, er: f32) -> f32 {
     let (l, r) = (el as f64, er as f64);
     let Some((pl, pr)) = Descent::probabilities(l, r) else {
         return f32::NAN;
@@ -91,38 +91,21 @@ impl<H: LightHierarchy> CutRules<H> {
 
     /// [`CutRules::new`] for a `config` known to be valid.
     fn with_valid_config(tree: H, config: CutConfig) -> Self {
-        let lights = &tree;
-        let split: Vec<f32> = (0..lights.node_count() as u32)
-            .map(|n| match lights.children(n) {
-                Some([l, r]) => encode_split(lights.power(l), lights.power(r)),
-                None => f32::NAN,
-            })
-            .collect();
-        let walk = WalkTable::new(lights, |n| {
-            split.get(n as usize).copied().unwrap_or(f32::NAN)
-        });
-        let importance = config
-            .uses_importance()
-            .then(|| ImportanceTable::new(lights, WalkTable::pair_nodes(lights).into_iter()));
-        let has_power = lights.root().is_some_and(|r| lights.power(r) > 0.0);
-        let pair_sets = match lights.has_light_sets() {
-            false => Vec::new(),
-            true => WalkTable::pair_nodes(lights)
-                .into_iter()
-                .map(|pair| match pair {
-                    Some(nodes) => nodes.map(|n| lights.light_sets(n)),
-                    None => [lights.root().map_or(0, |r| lights.light_sets(r)); 2],
-                })
-                .collect(),
+        let importance = config.uses_importance();
+        let (tables, instanced) = match tree.as_instanced() {
+            Some(inst) => (
+                TreeTables::new(inst.top(), importance),
+                Some(InstancedTables::new(inst, importance)),
+            ),
+            None => (TreeTables::new(&tree, importance), None),
         };
+        let has_power = tree.root().is_some_and(|r| tree.power(r) > 0.0);
         Self {
             tree,
-            split,
-            walk,
-            importance,
+            tables,
+            instanced,
             config,
             has_power,
-            pair_sets,
         }
     }
 
@@ -158,43 +141,51 @@ impl<H: LightHierarchy> CutRules<H> {
         self.has_power
     }
 
-    /// Heap bytes of the split table and the walk table (12 per
-    /// light-tree node).
+    /// Heap bytes of the tables (about 12 per light-tree node, 44 when a
+    /// rule uses importance; over an instanced tree, per node of its top
+    /// tree and meshes, plus about 120 per instance).
     pub fn bytes(&self) -> usize {
-        self.split.len() * core::mem::size_of::<f32>()
-            + self.walk.bytes()
-            + self.pair_sets.len() * core::mem::size_of::<[u64; 2]>()
-            + self.importance.as_ref().map_or(0, ImportanceTable::bytes)
+        self.tables.bytes() + self.instanced.as_ref().map_or(0, InstancedTables::bytes)
     }
 
-    /// The raw split-table entry of `node` (NaN for leaves and indices out
-    /// of range); [`decode_split`] turns it into probabilities.
+    /// The tables at the root, seeing the point as `fast`.
     #[inline(always)]
-    pub(crate) fn raw_split(&self, node: u32) -> f32 {
-        self.split.get(node as usize).copied().unwrap_or(f32::NAN)
+    pub(crate) fn top_segment(&self, fast: FastQuery) -> Segment<'_> {
+        self.tables.segment(self.tables.importance(), fast, None)
     }
 
-    /// The light sets of the children in walk-table pair `k` (`u64::MAX`
-    /// each when the tree has none).
+    /// Whether the walks read decoded importances (the configuration uses
+    /// importance).
     #[inline(always)]
-    pub(crate) fn pair_sets(&self, k: u32) -> [u64; 2] {
-        match self.pair_sets.get(k as usize) {
-            Some(&s) => s,
-            None => [u64::MAX; 2],
+    pub(crate) fn reads_importance(&self) -> bool {
+        self.tables.importance().is_some()
+    }
+
+    /// The per-mesh tables and the instanced tree, when the hierarchy is
+    /// one. Known `None` at compile time for a hierarchy that is not
+    /// ([`LightHierarchy::as_instanced`]'s default), so flat walks carry
+    /// no instancing code.
+    #[inline(always)]
+    pub(crate) fn instanced(&self) -> Option<(&InstancedTables, &InstancedLightTree)> {
+        let tree = self.tree.as_instanced()?;
+        Some((self.instanced.as_ref()?, tree))
+    }
+
+    /// Where a walk at `node` of `seg` goes on when `node` is the top
+    /// tree's leaf of an instance: its mesh's root, in its mesh's tables.
+    /// `None` anywhere else (the walk stays where it is).
+    #[inline(always)]
+    pub(crate) fn enter<'a>(
+        &'a self,
+        seg: &Segment<'a>,
+        node: WalkNode,
+    ) -> Option<(Segment<'a>, WalkNode)> {
+        let (tables, _) = self.instanced()?;
+        if seg.instance.is_some() || node.children().is_some() {
+            return None;
         }
-    }
-
-    /// The light tree laid out for sampling walks.
-    #[inline(always)]
-    pub(crate) fn walk(&self) -> &WalkTable {
-        &self.walk
-    }
-
-    /// The decoded nodes of the importance-based rules, when the
-    /// configuration uses one.
-    #[inline(always)]
-    pub(crate) fn importance_table(&self) -> Option<&ImportanceTable> {
-        self.importance.as_ref()
+        let inner = tables.segment(node.emitter()?, &seg.fast)?;
+        Some((inner, inner.walk.root()?))
     }
 
     /// The initial cut of a cell: the light tree's root split by power,

@@ -11,7 +11,7 @@ use crate::light_tree::{LightHierarchy, NodeBounds};
 use crate::math::scalar::{acos, sqrt};
 use alloc::vec::Vec;
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
+use glam::{Mat3A, Vec3, Vec3A};
 
 /// Slack on the emission-angle test, beyond the widening of the stored
 /// cones: `f32` rounding must never decide that a cluster cannot reach a
@@ -146,6 +146,27 @@ impl FastQuery {
         }
     }
 
+    /// This point seen from an instance's mesh space: the position
+    /// `to_mesh (p - origin)` (the world offset first, so a point near an
+    /// instance far from the world's origin keeps its precision), the
+    /// normal `normal_to_mesh n` renormalised (`M^T` for an instance's
+    /// linear part `M`: normals are covectors). An unused query stays
+    /// unused.
+    #[inline]
+    pub(crate) fn moved(&self, to_mesh: &Mat3A, origin: Vec3A, normal_to_mesh: &Mat3A) -> Self {
+        if !self.finite {
+            return *self;
+        }
+        let p = Vec3::from(*to_mesh * (Vec3A::from(self.p) - origin));
+        Self {
+            p,
+            n: self
+                .n
+                .and_then(|n| Vec3::from(*normal_to_mesh * Vec3A::from(n)).try_normalize()),
+            finite: p.is_finite(),
+        }
+    }
+
     /// A placeholder for walks that evaluate no importance (every
     /// importance it gives is 0).
     #[inline]
@@ -191,9 +212,17 @@ impl ImportanceTable {
         tree: &H,
         pairs: impl Iterator<Item = Option<[u32; 2]>>,
     ) -> Self {
+        Self::from_bounds(pairs, |n| tree.node_bounds(n))
+    }
+
+    /// [`ImportanceTable::new`] with each node's bounds from `bounds`.
+    pub(crate) fn from_bounds(
+        pairs: impl Iterator<Item = Option<[u32; 2]>>,
+        bounds: impl Fn(u32) -> NodeBounds,
+    ) -> Self {
         let pairs = pairs
             .map(|p| match p {
-                Some(nodes) => Pair(nodes.map(|n| Entry::new(&tree.node_bounds(n)))),
+                Some(nodes) => Pair(nodes.map(|n| Entry::new(&bounds(n)))),
                 None => Pair::default(),
             })
             .collect();

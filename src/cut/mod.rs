@@ -17,6 +17,10 @@
 //!   light tree, mixed with the prior and the unbounded lights);
 //! - `walk.rs`: the light tree re-laid out for the sampling walk (both
 //!   children of a node in one 16-byte load);
+//! - `tables.rs`: a light tree's tables as the walks read them, and the
+//!   `Segment` a walk is in; `instanced_tables.rs`: those of an
+//!   [`crate::InstancedLightTree`], one set per mesh shared by its
+//!   instances;
 //! - `splat.rs`: recording direct-light estimates into a cut
 //!   ([`CutRules::splat`]);
 //! - `vertex.rs`: [`LightVertex`], a located cell's cut as a
@@ -53,11 +57,13 @@ mod cut_node;
 mod cut_rules;
 mod guiding_cut;
 mod importance_table;
+mod instanced_tables;
 mod octants;
 mod persist;
 mod refine;
 mod sampling;
 mod splat;
+mod tables;
 mod vertex;
 mod visibility;
 mod walk;

@@ -5,7 +5,8 @@ use super::config::{Modulation, SplitPrior};
 use super::cut_node::{CutNode, Slot};
 use super::cut_rules::CutRules;
 use super::guiding_cut::{GuidingCut, sum_count};
-use super::importance_table::{FastQuery, ImportanceTable};
+use super::importance_table::FastQuery;
+use super::tables::Segment;
 use super::walk::WalkNode;
 use crate::light_sampler::ShadingContext;
 use crate::light_tree::LightHierarchy;
@@ -19,11 +20,13 @@ const ROOT: u32 = u32::MAX;
 
 /// A slot still to decide: where it hangs, the light node it stands for, its
 /// weight and the old cut node that stood for the same light node (if any).
-struct Task {
+struct Task<'a> {
     parent: u32,
     side: Side,
     light: u32,
-    /// The light node's walk-table entry (locates its children's pair).
+    /// The tables the light node is in (an instance's mesh's, inside one)
+    /// and its walk-table entry there (locates its children's pair).
+    seg: Segment<'a>,
     walk: WalkNode,
     weight: f64,
     old: Option<u32>,
@@ -134,7 +137,7 @@ impl<H: LightHierarchy> CutRules<H> {
 
     /// What a refinement of `cut` starts from; `None` when the cut keeps
     /// accumulating ([`CutConfig::min_splats`](super::CutConfig::min_splats)).
-    fn plan(&self, cut: &GuidingCut) -> Option<Plan<'_>> {
+    fn plan(&self, cut: &GuidingCut) -> Option<Plan> {
         let config = self.config();
         if cut.recorded.get() < u64::from(config.min_splats) {
             return None;
@@ -143,10 +146,10 @@ impl<H: LightHierarchy> CutRules<H> {
         // The importances at the anchor come from the same table (and
         // the same function) that sampling modulates with, so at the
         // anchor the modulated cut is exactly the learned one.
-        let anchor = match (config.modulation, self.importance_table()) {
-            (Modulation::Importance, Some(table)) => cut
-                .anchor()
-                .map(|a| (table, FastQuery::new(&ShadingContext::at(a)))),
+        let anchor = match (config.modulation, self.reads_importance()) {
+            (Modulation::Importance, true) => {
+                cut.anchor().map(|a| FastQuery::new(&ShadingContext::at(a)))
+            }
             _ => None,
         };
         Some(Plan {
@@ -160,10 +163,10 @@ impl<H: LightHierarchy> CutRules<H> {
 }
 
 /// The sums a refinement reads, and the anchor it modulates with.
-struct Plan<'a> {
+struct Plan {
     sums: Vec<f64>,
     unbounded: Vec<f64>,
-    anchor: Option<(&'a ImportanceTable, FastQuery)>,
+    anchor: Option<FastQuery>,
 }
 
 /// Weight of each old cut node's subtree (children follow parents, so one
@@ -208,17 +211,6 @@ fn split_weight<H: LightHierarchy + ?Sized>(
     }
 }
 
-/// The importances of `children` at the anchor, with a floor of 1e-6 of
-/// their sum so a cluster that the bound calls dark there but that did
-/// collect splats keeps a finite factor; `None` when both are zero (or
-/// not finite).
-fn anchor_importances(
-    (table, anchor): (&ImportanceTable, FastQuery),
-    pair: u32,
-) -> Option<(f64, f64)> {
-    floored(table.pair_importance(&anchor, pair))
-}
-
 /// Two importances, each at least 1e-6 of their sum; `None` when the sum
 /// is zero or not finite.
 fn floored((l, r): (f64, f64)) -> Option<(f64, f64)> {
@@ -258,18 +250,22 @@ fn stored_p_left(weights: (f64, f64), importances: Option<(f64, f64)>) -> f32 {
     }
 }
 
-fn rebuild<H: LightHierarchy>(
-    guide: &CutRules<H>,
+fn rebuild<'a, H: LightHierarchy>(
+    guide: &'a CutRules<H>,
     old: &[CutNode],
     sums: &[f64],
     total: f64,
-    anchor: Option<(&ImportanceTable, FastQuery)>,
+    anchor: Option<FastQuery>,
     sigma: f64,
 ) -> Vec<CutNode> {
-    let (tree, config, walk) = (guide.light_tree(), guide.config(), guide.walk());
-    let (Some(root), Some(root_walk)) = (tree.root(), walk.root()) else {
+    let (tree, config) = (guide.light_tree(), guide.config());
+    let top = guide.top_segment(anchor.unwrap_or(FastQuery::unused()));
+    let (Some(root), Some(root_walk)) = (tree.root(), top.walk.root()) else {
         return Vec::new();
     };
+    // A walk-table entry, moved to its mesh's root at an instance's leaf.
+    let place = |seg: Segment<'a>, walk| guide.enter(&seg, walk).unwrap_or((seg, walk));
+    let (seg, walk) = place(top, root_walk);
     let threshold = sigma * total;
     let old_weights = subtree_weights(old, sums);
     let mut nodes: Vec<CutNode> = Vec::new();
@@ -277,7 +273,8 @@ fn rebuild<H: LightHierarchy>(
         parent: ROOT,
         side: Side::Left,
         light: root,
-        walk: root_walk,
+        seg,
+        walk,
         weight: total,
         old: (!old.is_empty()).then_some(0),
     }];
@@ -285,7 +282,12 @@ fn rebuild<H: LightHierarchy>(
         let mut slot = Slot::End(t.light);
         let split = tree.children(t.light).zip(t.walk.children());
         if let Some((children, pair)) = split.filter(|_| t.weight > threshold) {
-            let imp = anchor.and_then(|a| anchor_importances(a, pair));
+            // The importances at the anchor come from the table and the
+            // function sampling modulates with, the anchor seen as the
+            // walk sees the point (in mesh space inside an instance).
+            let imp = anchor
+                .and_then(|_| t.seg.child_importances(t.walk))
+                .and_then(floored);
             // Each side's weight and the old node that stands for it.
             let sides: [(f64, Option<u32>); 2] = match t.old.and_then(|i| old.get(i as usize)) {
                 Some(o) => {
@@ -317,14 +319,16 @@ fn rebuild<H: LightHierarchy>(
                 ));
                 // Right first so the left subtree is numbered first
                 // (pre-order).
-                let walks = walk.pair(pair).0;
+                let walks = t.seg.walk.pair(pair).0;
                 for side in [Side::Right, Side::Left] {
                     let (weight, old) = sides[side.index()];
+                    let (seg, walk) = place(t.seg, walks[side.index()]);
                     stack.push(Task {
                         parent: index,
                         side,
                         light: children[side.index()],
-                        walk: walks[side.index()],
+                        seg,
+                        walk,
                         weight,
                         old,
                     });

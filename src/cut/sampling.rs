@@ -39,11 +39,13 @@ use super::config::{BelowCut, CutConfig, Modulation, Prior};
 use super::cut_node::CutNode;
 use super::cut_rules::{CutRules, decode_split};
 use super::guiding_cut::{GuidingCut, sum_count};
-use super::importance_table::{FastQuery, ImportanceTable};
+use super::importance_table::FastQuery;
+use super::instanced_tables::{InstancedTables, mesh_of};
+use super::tables::Segment;
 use super::walk::WalkNode;
 use crate::light_sampler::ShadingContext;
 use crate::light_sampler::{LightId, LightSample, choose_unbounded};
-use crate::light_tree::LightHierarchy;
+use crate::light_tree::{InstancedLightTree, LightHierarchy};
 use crate::math::{Descent, Side, pmf_to_f32};
 
 /// The probabilities of the top-level choices in one cell.
@@ -172,13 +174,23 @@ impl Mixture {
     }
 }
 
-/// Where a walk is: a light-tree node's walk-table entry (which also
-/// locates its children in the importance table) and, while inside the
-/// cut, the cut node that stands for it.
+/// Where a walk is: a light-tree node's walk-table entry in the walk's
+/// current [`Segment`] (which also locates its children in the importance
+/// table) and, while inside the cut, the cut node that stands for it.
 #[derive(Clone, Copy, Debug)]
 struct Cursor {
     node: WalkNode,
     cut: Option<CutNode>,
+}
+
+/// A sampling walk's state: where it is, the products so far, and the
+/// cut node it is in while it is inside the cut (tracked only when the
+/// caller asks for the slot it leaves the cut by).
+#[derive(Clone, Copy, Debug)]
+struct Walk {
+    at: Cursor,
+    p: Products,
+    in_cut: Option<u32>,
 }
 
 /// The probabilities at one inner light-tree node.
@@ -223,6 +235,9 @@ fn pick((pl, pr): (f64, f64), side: Side) -> f64 {
 struct Rule<'b, H: LightHierarchy, R: Restriction> {
     guide: &'b CutRules<H>,
     tree: &'b H,
+    /// The tables at the root, with the shading point prepared for the
+    /// decoded nodes (only the importance rules read it).
+    top: Segment<'b>,
     nodes: &'b [CutNode],
     below: BelowCut,
     /// Whether the cut's probabilities follow the importance at the
@@ -230,11 +245,6 @@ struct Rule<'b, H: LightHierarchy, R: Restriction> {
     modulate: bool,
     /// Whether the prior component follows the importance ([`Prior`]).
     prior_importance: bool,
-    /// The decoded nodes; the guide has them whenever its configuration
-    /// uses importance.
-    table: Option<&'b ImportanceTable>,
-    /// The shading point, prepared for the decoded nodes.
-    fast: FastQuery,
     /// Whether the prior component has weight (else its product is not
     /// tracked and stays 1, multiplied by a zero weight).
     prior: bool,
@@ -352,16 +362,14 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
         Self {
             guide,
             tree: guide.light_tree(),
+            top: guide.top_segment(match guide.reads_importance() {
+                true => FastQuery::new(ctx),
+                false => FastQuery::unused(),
+            }),
             nodes: &cut.nodes,
             below: config.below_cut,
             modulate,
             prior_importance,
-            table: guide.importance_table(),
-            // Only the importance rules read the prepared point.
-            fast: match guide.importance_table() {
-                Some(_) => FastQuery::new(ctx),
-                None => FastQuery::unused(),
-            },
             prior: mixture.prior > 0.0,
             mixture,
             unbounded: &cut.unbounded,
@@ -372,7 +380,7 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
     #[inline(always)]
     fn root(&self) -> Option<Cursor> {
         Some(Cursor {
-            node: self.guide.walk().root()?,
+            node: self.top.walk.root()?,
             cut: self.nodes.first().copied(),
         })
     }
@@ -386,16 +394,8 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
             .map(|c| c.and_then(|i| self.nodes.get(i as usize).copied()))
     }
 
-    /// The importances of the two children of the inner node at `at` at the
-    /// shading point, from the decoded table (both children in one cache
-    /// line, found by the walk-table pair).
-    #[inline(always)]
-    fn child_importances(&self, at: &Cursor) -> Option<(f64, f64)> {
-        Some(self.table?.pair_importance(&self.fast, at.node.children()?))
-    }
-
-    /// The probabilities of both components at the inner node `at`, whose
-    /// split-table entry is `split`.
+    /// The probabilities of both components at the inner node `at` of
+    /// segment `seg`, whose split-table entry is `split`.
     ///
     /// - Inside the cut the learned component takes the cut node's
     ///   `p_left`, or with [`Modulation::Importance`] the learned factor
@@ -409,7 +409,7 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
     ///
     /// Light sets restrict it afterwards ([`Restriction::restrict`]).
     #[inline(always)]
-    fn step(&self, at: Cursor, split: f32) -> Step {
+    fn step(&self, seg: &Segment, at: Cursor, split: f32) -> Step {
         let power = decode_split(split);
         let needs_importance = self.prior_importance
             || match at.cut {
@@ -417,7 +417,7 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
                 None => self.below == BelowCut::Importance,
             };
         let imp = if needs_importance {
-            self.child_importances(&at)
+            seg.child_importances(at.node)
         } else {
             None
         };
@@ -507,29 +507,59 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
             (false, true) => false,
             (false, false) => return None,
         };
-        let mut at = self.root()?;
-        let mut p = Products {
-            cut: 1.0,
-            prior: 1.0,
+        let at = self.root()?;
+        let mut w = Walk {
+            at,
+            p: Products {
+                cut: 1.0,
+                prior: 1.0,
+            },
+            // The cut node the walk is in (the root's only slot when the
+            // cut has no nodes).
+            in_cut: at.cut.filter(|_| SUM).map(|_| 0u32),
         };
-        let walk = self.guide.walk();
-        let mut children = at.node.children().map(|k| walk.pair(k));
-        // The cut node the walk is in, and the slot it left the cut by
-        // (the root's only slot when the cut has no nodes).
-        let mut in_cut = at.cut.filter(|_| SUM).map(|_| 0u32);
         if SUM {
             *sum = 0;
         }
+        self.descend::<SUM>(&self.top, &mut w, &mut d, use_cut, sum)?;
+        let leaf = w.at.node.emitter()?;
+        let emitter = match self.guide.instanced() {
+            None => leaf,
+            Some((tables, _)) => {
+                self.descend_instance::<SUM>(tables, leaf, &mut w, d, use_cut, sum)?
+            }
+        };
+        Some((LightId::Emitter(emitter), m.emitter_pmf(w.p)))
+    }
+
+    /// Walks `w` down segment `seg` to a leaf with the descent `d`, under
+    /// the cut's probabilities when `use_cut` (else the prior's), writing
+    /// the slot the walk leaves the cut by to `sum` when `SUM`. `None`
+    /// where neither side can be chosen.
+    #[inline(always)]
+    fn descend<const SUM: bool>(
+        &self,
+        seg: &Segment,
+        w: &mut Walk,
+        d: &mut Descent,
+        use_cut: bool,
+        sum: &mut usize,
+    ) -> Option<()> {
+        let walk = seg.walk;
+        // A copy the loop keeps in registers, written back at the end.
+        let (mut at, mut p, mut in_cut) = (w.at, w.p, w.in_cut);
+        let mut children = at.node.children().map(|k| walk.pair(k));
         while let Some(pair) = children {
             // Load the next level for both sides before choosing: these
             // loads do not depend on `u`, so they overlap with this level's
             // choice instead of waiting for it (the walk is latency-bound).
             let grand = walk.grandchildren(pair);
-            let step =
-                self.restriction
-                    .restrict(self.step(at, at.node.split), at.node.split, || {
-                        at.node.children().map(|k| self.guide.pair_sets(k))
-                    });
+            let split = at.node.split;
+            let step = self
+                .restriction
+                .restrict(self.step(seg, at, split), split, || {
+                    at.node.children().map(|k| seg.pair_sets(k))
+                });
             let cuts = self.cut_children(&step);
             let (pl, pr) = if use_cut { step.cut } else { step.prior }?;
             let side = d.choose_with(pl, pr);
@@ -547,8 +577,27 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
             };
             children = at.node.children().map(|_| grand[k]);
         }
-        let emitter = at.node.emitter()?;
-        Some((LightId::Emitter(emitter), m.emitter_pmf(p)))
+        *w = Walk { at, p, in_cut };
+        Some(())
+    }
+
+    /// The walk on from the top tree's leaf of instance `i`: into its
+    /// mesh's tables, the point seen from mesh space, down to an emitter;
+    /// its id.
+    #[inline(always)]
+    fn descend_instance<const SUM: bool>(
+        &self,
+        tables: &InstancedTables,
+        i: u32,
+        w: &mut Walk,
+        mut d: Descent,
+        use_cut: bool,
+        sum: &mut usize,
+    ) -> Option<u32> {
+        let seg = tables.segment(i, &self.top.fast)?;
+        w.at.node = seg.walk.root()?;
+        self.descend::<SUM>(&seg, w, &mut d, use_cut, sum)?;
+        tables.emitter_id(i, w.at.node.emitter()?)
     }
 
     /// The `f64` pmf of `light`: the same steps along its path.
@@ -566,39 +615,97 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
         if self.mixture.cut <= 0.0 && !self.prior {
             return 0.0;
         }
-        let (Some(mut at), Some(path)) = (self.root(), self.tree.path(emitter)) else {
+        let Some(mut at) = self.root() else {
             return 0.0;
         };
         let mut p = Products {
             cut: 1.0,
             prior: 1.0,
         };
-        // The path names every node, so the split loads are independent of
-        // each other (unlike the walk table's chain, which `sample` follows
-        // because it does not know the path in advance).
-        let walk = self.guide.walk();
-        for &(node, side) in path.steps() {
-            let split = self.guide.raw_split(node);
-            let step = self.restriction.restrict(self.step(at, split), split, || {
-                self.tree
-                    .children(node)
-                    .map(|c| c.map(|n| self.tree.light_sets(n)))
-            });
-            self.apply(&mut p, &step, side);
+        let found = match self.guide.instanced() {
+            None => self
+                .tree
+                .path(emitter)
+                .is_some_and(|path| self.pmf_along(&self.top, &mut at, &mut p, path.steps())),
+            Some((tables, tree)) => self.pmf_instanced(tables, tree, emitter, &mut at, &mut p),
+        };
+        match found {
+            true => self.mixture.emitter_pmf(p),
+            false => 0.0,
+        }
+    }
+
+    /// [`Rule::pmf_along`] the path of `emitter` over an instanced tree:
+    /// the top tree's path to its instance, then its mesh's path to it in
+    /// the mesh's tables, the point seen from mesh space.
+    #[inline(always)]
+    fn pmf_instanced(
+        &self,
+        tables: &InstancedTables,
+        tree: &InstancedLightTree,
+        emitter: u32,
+        at: &mut Cursor,
+        p: &mut Products,
+    ) -> bool {
+        let Some((i, t)) = tree.locate(emitter) else {
+            return false;
+        };
+        let (Some(top), Some(inner)) =
+            (tree.top().path(i), mesh_of(tree, i).and_then(|m| m.path(t)))
+        else {
+            return false;
+        };
+        if !self.pmf_along(&self.top, at, p, top.steps()) {
+            return false;
+        }
+        let Some(seg) = tables.segment(i, &self.top.fast) else {
+            return false;
+        };
+        let Some(root) = seg.walk.root() else {
+            return false;
+        };
+        at.node = root;
+        self.pmf_along(&seg, at, p, inner.steps())
+    }
+
+    /// Multiplies into `p` the steps along `path` in segment `seg`, from
+    /// `at`; false as soon as both products are 0 (or the walk table does
+    /// not follow the path).
+    ///
+    /// The path names every node, so the split loads are independent of
+    /// each other (unlike the walk table's chain, which `sample` follows
+    /// because it does not know the path in advance).
+    #[inline(always)]
+    fn pmf_along(
+        &self,
+        seg: &Segment,
+        at: &mut Cursor,
+        p: &mut Products,
+        path: &[(u32, Side)],
+    ) -> bool {
+        // Follow the walk table too (the importance table and the light
+        // sets are laid out like it), only when they are read.
+        let follow = seg.importance.is_some() || R::LINKED;
+        for &(node, side) in path {
+            let split = seg.raw_split(node);
+            let step = self
+                .restriction
+                .restrict(self.step(seg, *at, split), split, || {
+                    at.node.children().map(|k| seg.pair_sets(k))
+                });
+            self.apply(p, &step, side);
             if p.cut == 0.0 && (!self.prior || p.prior == 0.0) {
-                return 0.0;
+                return false;
             }
             at.cut = step.next[side.index()].and_then(|i| self.nodes.get(i as usize).copied());
-            // Follow the walk table too (the importance table is laid out
-            // like it), only when it is read.
-            if self.table.is_some() {
+            if follow {
                 match at.node.children() {
-                    Some(k) => at.node = walk.pair(k).0[side.index()],
-                    None => return 0.0,
+                    Some(k) => at.node = seg.walk.pair(k).0[side.index()],
+                    None => return false,
                 }
             }
         }
-        self.mixture.emitter_pmf(p)
+        true
     }
 }
 

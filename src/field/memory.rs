@@ -18,9 +18,8 @@ pub struct FieldMemory {
     /// The cuts together. Their `inline_bytes` are already in
     /// `sd.spatial_bytes` and are not added again in the totals.
     pub cuts: CutMemory,
-    /// The [`CutRules`](crate::cut::CutRules)'s split table, shared
-    /// by all cells: split and walk tables, 12 bytes per light-tree node
-    /// (plus 8).
+    /// The [`CutRules`](crate::cut::CutRules)'s tables, shared by all
+    /// cells ([`CutRules::bytes`](crate::cut::CutRules::bytes)).
     pub shared_bytes: usize,
 }
 

@@ -13,8 +13,8 @@ pub struct GltMemory {
     /// the inline [`GltCell`](super::GltCell) values (which include the cuts' inline parts,
     /// so those are not added twice in [`GltMemory::total`]).
     pub spatial_bytes: usize,
-    /// The [`CutRules`](crate::cut::CutRules)'s split and walk tables, shared by all cells (12
-    /// bytes per light-tree node, plus 8).
+    /// The [`CutRules`](crate::cut::CutRules)'s tables, shared by all
+    /// cells ([`CutRules::bytes`](crate::cut::CutRules::bytes)).
     pub shared_bytes: usize,
 }
 

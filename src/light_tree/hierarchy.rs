@@ -1,4 +1,4 @@
-use super::EmitterPath;
+use super::{EmitterPath, InstancedLightTree};
 use crate::math::{Aabb, LightCone, Side};
 
 /// What a tree node knows about the lights below it: enough for the
@@ -59,6 +59,16 @@ pub trait LightHierarchy {
     /// the sets entirely); false by default.
     fn has_light_sets(&self) -> bool {
         false
+    }
+
+    /// This hierarchy as an [`InstancedLightTree`], when it is one: the
+    /// GLT then lays out its tables once per mesh, shared by the mesh's
+    /// instances, instead of once per node of the flat tree it stands for
+    /// (a few megabytes instead of gigabytes for thousands of instances of
+    /// a large mesh). `None` by default, which a hierarchy of your own
+    /// keeps.
+    fn as_instanced(&self) -> Option<&InstancedLightTree> {
+        None
     }
 
     /// The root-to-leaf path of `emitter`, at any depth; `None` when out of
@@ -136,6 +146,10 @@ macro_rules! forward_hierarchy {
             #[inline(always)]
             fn has_light_sets(&self) -> bool {
                 (**self).has_light_sets()
+            }
+            #[inline(always)]
+            fn as_instanced(&self) -> Option<&InstancedLightTree> {
+                (**self).as_instanced()
             }
         }
     )*};

@@ -55,9 +55,9 @@ impl Instance {
 
 /// A placed instance as the hierarchy reads it.
 #[derive(Clone, Copy, Debug)]
-struct Placed {
-    mesh: u32,
-    transform: Affine3A,
+pub(crate) struct Placed {
+    pub(crate) mesh: u32,
+    pub(crate) transform: Affine3A,
     /// `|M|`, the absolute linear part: a local box's half extent maps to
     /// at most `|M| * extent`.
     abs_linear: [Vec3A; 3],
@@ -65,13 +65,13 @@ struct Placed {
     /// Whether the transform keeps angles (a rotation, mirror and uniform
     /// scale), so a normal cone maps to a cone of the same angle; else
     /// instance nodes are bounded by the whole sphere of directions.
-    similar: bool,
+    pub(crate) similar: bool,
     /// The sign of the transform's determinant: a mirror turns a
     /// triangle's winding, and so the side it emits on.
-    handedness: f32,
+    pub(crate) handedness: f32,
     /// The instance's first node past its root, and its first emitter.
     node_base: u32,
-    emitter_base: u32,
+    pub(crate) emitter_base: u32,
 }
 
 /// A light tree over instances of emissive meshes: one [`LightTree`] per
@@ -89,8 +89,13 @@ struct Placed {
 /// pmf, normalised) and the GLT's cuts descend into the instances. Nodes
 /// `0..top` are the top tree's (instance `i`'s leaf is its mesh's root);
 /// instance `i`'s other nodes follow, in instance order. Queries inside an
-/// instance find it by binary search over the instances (O(log
-/// instances)).
+/// instance find it through an index over the node ids (a step or two).
+///
+/// The GLT over it ([`crate::Glt`], [`crate::GuidingField`]) keeps its
+/// tables per mesh, shared by the mesh's instances
+/// ([`LightHierarchy::as_instanced`]): its walk enters an instance's mesh
+/// tree with the shading point moved into mesh space, so its memory grows
+/// with the meshes and instances, not with the triangles placed.
 ///
 /// ```
 /// use guiding::glam::{Affine3A, Vec3};
@@ -241,6 +246,11 @@ impl InstancedLightTree {
             + self.top.bytes()
             + self.instances.len() * core::mem::size_of::<Placed>()
             + self.buckets.len() * core::mem::size_of::<u32>()
+    }
+
+    /// The placements, in instance order.
+    pub(crate) fn placements(&self) -> &[Placed] {
+        &self.instances
     }
 
     /// The instance (index and placement) and mesh node of node `node`
@@ -445,5 +455,10 @@ impl LightHierarchy for InstancedLightTree {
 
     fn emitter_count(&self) -> usize {
         self.emitter_count as usize
+    }
+
+    #[inline(always)]
+    fn as_instanced(&self) -> Option<&InstancedLightTree> {
+        Some(self)
     }
 }

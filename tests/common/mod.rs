@@ -350,3 +350,7 @@ pub fn chi_square_z(observed: &[u64], probs: &[f64]) -> Option<(f64, usize)> {
 mod at_point;
 #[allow(unused_imports)]
 pub use at_point::{ByPosition, DirectionsAt, LightsAt};
+
+mod flattened;
+#[allow(unused_imports)]
+pub use flattened::Flattened;

@@ -1,0 +1,146 @@
+//! [`TreeTables`]: what the GLT's walks read of one light tree, and
+//! [`Segment`]: the tables a walk is in, with the shading point as they
+//! see it.
+//!
+//! A flat hierarchy has one set of tables and every walk is one segment.
+//! Over an [`InstancedLightTree`](crate::InstancedLightTree) the top tree
+//! has one and each mesh one (`instanced_tables.rs`), and a walk is two
+//! segments: the top tree to an instance's leaf, then its mesh's tree with
+//! the point moved into mesh space.
+
+use super::cut_rules::encode_split;
+use super::importance_table::{FastQuery, ImportanceTable};
+use super::walk::{WalkNode, WalkTable};
+use crate::light_tree::LightHierarchy;
+use alloc::vec::Vec;
+
+/// The tables of one light tree: each inner node's power split (4 bytes
+/// per node, see `encode_split`), the tree re-laid out for sampling walks
+/// (8 bytes per node, `walk.rs`), the decoded importance table when a rule
+/// uses importance (32 bytes per node) and, when the tree has light sets,
+/// both children's sets per walk-table pair.
+#[derive(Clone, Debug)]
+pub(crate) struct TreeTables {
+    split: Vec<f32>,
+    walk: WalkTable,
+    importance: Option<ImportanceTable>,
+    /// The light sets of both children of each walk-table pair (the
+    /// root's pair: the root's, twice); empty when the tree has no light
+    /// sets.
+    pair_sets: Vec<[u64; 2]>,
+}
+
+impl TreeTables {
+    /// The tables of `tree`, the importance table only when `importance`.
+    /// O(nodes).
+    pub(crate) fn new<T: LightHierarchy + ?Sized>(tree: &T, importance: bool) -> Self {
+        let split: Vec<f32> = (0..tree.node_count() as u32)
+            .map(|n| match tree.children(n) {
+                Some([l, r]) => encode_split(tree.power(l), tree.power(r)),
+                None => f32::NAN,
+            })
+            .collect();
+        let walk = WalkTable::new(tree, |n| split.get(n as usize).copied().unwrap_or(f32::NAN));
+        let importance =
+            importance.then(|| ImportanceTable::new(tree, WalkTable::pair_nodes(tree).into_iter()));
+        let pair_sets = match tree.has_light_sets() {
+            false => Vec::new(),
+            true => WalkTable::pair_nodes(tree)
+                .into_iter()
+                .map(|pair| match pair {
+                    Some(nodes) => nodes.map(|n| tree.light_sets(n)),
+                    None => [tree.root().map_or(0, |r| tree.light_sets(r)); 2],
+                })
+                .collect(),
+        };
+        Self {
+            split,
+            walk,
+            importance,
+            pair_sets,
+        }
+    }
+
+    /// Heap bytes.
+    pub(crate) fn bytes(&self) -> usize {
+        self.split.len() * core::mem::size_of::<f32>()
+            + self.walk.bytes()
+            + self.pair_sets.len() * core::mem::size_of::<[u64; 2]>()
+            + self.importance.as_ref().map_or(0, ImportanceTable::bytes)
+    }
+
+    /// The decoded importance table, when built.
+    #[inline(always)]
+    pub(crate) fn importance(&self) -> Option<&ImportanceTable> {
+        self.importance.as_ref()
+    }
+
+    /// A walk through these tables seeing the point as `fast`, reading
+    /// importances from `importance` (this tree's own table, or one of
+    /// its views: see `instanced_tables.rs`); `instance` names the
+    /// instance whose mesh these tables are, `None` for the top.
+    #[inline(always)]
+    pub(crate) fn segment<'a>(
+        &'a self,
+        importance: Option<&'a ImportanceTable>,
+        fast: FastQuery,
+        instance: Option<u32>,
+    ) -> Segment<'a> {
+        Segment {
+            split: &self.split,
+            walk: &self.walk,
+            importance,
+            pair_sets: &self.pair_sets,
+            fast,
+            instance,
+        }
+    }
+}
+
+/// The tables a walk is in and the shading point as they see it: the
+/// whole walk over a flat hierarchy; over an instanced one, the top tree
+/// or, inside instance `instance`, its mesh's tree in mesh space.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Segment<'a> {
+    split: &'a [f32],
+    /// The tree laid out for sampling walks.
+    pub(crate) walk: &'a WalkTable,
+    /// The decoded importances, when a rule reads them.
+    pub(crate) importance: Option<&'a ImportanceTable>,
+    pair_sets: &'a [[u64; 2]],
+    /// The shading point as these tables see it.
+    pub(crate) fast: FastQuery,
+    /// The instance this segment is inside; `None` for the top tree (or a
+    /// flat one).
+    pub(crate) instance: Option<u32>,
+}
+
+impl Segment<'_> {
+    /// The raw split-table entry of `node` (NaN for leaves and indices out
+    /// of range); `decode_split` turns it into probabilities.
+    #[inline(always)]
+    pub(crate) fn raw_split(&self, node: u32) -> f32 {
+        self.split.get(node as usize).copied().unwrap_or(f32::NAN)
+    }
+
+    /// The light sets of the children in walk-table pair `k` (`u64::MAX`
+    /// each when the tree has none).
+    #[inline(always)]
+    pub(crate) fn pair_sets(&self, k: u32) -> [u64; 2] {
+        match self.pair_sets.get(k as usize) {
+            Some(&s) => s,
+            None => [u64::MAX; 2],
+        }
+    }
+
+    /// The importances at the point of the two children of the inner node
+    /// `node`, from the decoded table (both in one cache line, found by
+    /// the walk-table pair); `None` without a table or at a leaf.
+    #[inline(always)]
+    pub(crate) fn child_importances(&self, node: WalkNode) -> Option<(f64, f64)> {
+        Some(
+            self.importance?
+                .pair_importance(&self.fast, node.children()?),
+        )
+    }
+}
