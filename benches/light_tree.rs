@@ -19,7 +19,7 @@ use criterion::{
 use glam::{Affine3A, Quat, Vec3};
 use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::ImportanceTreeSampler;
-use guiding::light_tree::BuildHeuristic;
+use guiding::light_tree::{BuildHeuristic, shape_fingerprint};
 use guiding::math::Aabb;
 use guiding::{
     Emitter, Instance, InstancedLightTree, LightHierarchy, LightId, LightSampler, LightTree,
@@ -202,6 +202,15 @@ fn instanced(c: &mut Criterion) {
         glt.memory().shared_bytes as f64 / (1 << 20) as f64,
         glt.memory().total() as f64 / (1 << 20) as f64
     );
+    // What hashing the flat tree node by node costs (what saving and
+    // loading did before the fingerprint hashed the parts).
+    let start = std::time::Instant::now();
+    let every_node = shape_fingerprint(&Flattened(&tree));
+    println!(
+        "  shape fingerprint node by node, 8000 instances: {:.2} s ({every_node:x}); by parts: {:x}",
+        start.elapsed().as_secs_f64(),
+        shape_fingerprint(&tree)
+    );
     let small: Vec<InstancedLightTree> = [50, 200]
         .map(|count| instanced_tree(&triangles, &all[..count]))
         .into();
@@ -222,6 +231,15 @@ fn instanced(c: &mut Criterion) {
     });
     group.bench_function(BenchmarkId::new("glt", "8000x5000"), |b| {
         b.iter(|| Glt::new(black_box(&tree), scene, GltConfig::default()))
+    });
+    // Saving and loading bind the state to the tree's shape fingerprint,
+    // over an instanced tree hashed by its parts.
+    let saved = glt.to_bytes();
+    group.bench_function(BenchmarkId::new("glt-save", "8000x5000"), |b| {
+        b.iter(|| black_box(&glt).to_bytes())
+    });
+    group.bench_function(BenchmarkId::new("glt-load", "8000x5000"), |b| {
+        b.iter(|| Glt::from_bytes(black_box(&saved), &tree))
     });
     for t in &small {
         let count = t.top().emitter_count();

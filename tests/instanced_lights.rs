@@ -10,8 +10,9 @@ use glam::{Affine3A, Quat, Vec3};
 use guiding::cut::CutConfig;
 use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::{ImportanceTreeSampler, PowerTreeSampler};
-use guiding::light_tree::BuildHeuristic;
+use guiding::light_tree::{BuildHeuristic, fingerprint, shape_fingerprint};
 use guiding::math::Aabb;
+use guiding::persist::LoadError;
 use guiding::{
     BuildError, Emitter, Instance, InstancedLightTree, LightHierarchy, LightId, LightSampler,
     LightTree, ShadingContext,
@@ -56,6 +57,11 @@ struct Scene {
 /// rotated and scaled, mirrored, stretched (a non-uniform scale), one
 /// emitting 5x.
 fn scene() -> Scene {
+    scene_with(|_| {})
+}
+
+/// [`scene`] with its instances changed by `change` before the build.
+fn scene_with(change: impl Fn(&mut Vec<Instance>)) -> Scene {
     let mut r = Rand::new(71);
     let meshes: Vec<Vec<Triangle>> = [40, 1, 0].map(|n| mesh(n, &mut r)).into();
     let trees: Vec<LightTree> = meshes
@@ -87,6 +93,7 @@ fn scene() -> Scene {
         let inst = Instance::new(mesh, transform);
         instances.push(if i == 3 { inst.emitting(5.0) } else { inst });
     }
+    change(&mut instances);
     let tree = InstancedLightTree::build(trees, &instances, BuildHeuristic::Sarh).unwrap();
     let flat = instances
         .iter()
@@ -371,6 +378,95 @@ fn the_glts_tables_grow_with_meshes_not_placed_triangles() {
     let world = Glt::new(Flattened(&tree), bounds, GltConfig::default()).unwrap();
     let (s, w) = (shared.memory().shared_bytes, world.memory().shared_bytes);
     assert!(20 * s < w, "{s} bytes shared vs {w} over every node");
+}
+
+/// A GLT over instances is saved, loaded, refitted and merged by the
+/// parts of its tree (`shape_fingerprint` and `fingerprint` hash the top
+/// tree, the meshes and the instances, not the flat tree node by node):
+/// it loads back exactly, over the tree moved as a whole too (the same
+/// shape), and nowhere the instances place other meshes; it merges only
+/// with a copy over the same tree.
+#[test]
+fn a_glt_over_instances_saves_and_binds_by_its_parts() {
+    let Scene { tree, flat } = scene();
+    let glt = trained_glt(&tree, &flat, CutConfig::default());
+    let bytes = glt.to_bytes();
+    let back = Glt::from_bytes(&bytes, &tree).unwrap();
+    let mut r = Rand::new(79);
+    for _ in 0..20 {
+        let ctx = ShadingContext::on_surface(r.point(50.0), r.dir());
+        let (a, b) = (glt.vertex(&ctx).unwrap(), back.vertex(&ctx).unwrap());
+        for e in 0..flat.len() as u32 {
+            let l = LightId::Emitter(e);
+            assert_eq!(
+                a.pmf_exact(&ctx, l).to_bits(),
+                b.pmf_exact(&ctx, l).to_bits()
+            );
+        }
+    }
+    // Moved as a whole: the same shape, other bounds.
+    let moved = scene_with(|instances| {
+        for inst in instances.iter_mut() {
+            inst.transform.translation += glam::Vec3A::new(64.0, 0.0, 0.0);
+        }
+    });
+    assert_eq!(shape_fingerprint(&moved.tree), shape_fingerprint(&tree));
+    assert_ne!(fingerprint(&moved.tree), fingerprint(&tree));
+    assert!(Glt::from_bytes(&bytes, &moved.tree).is_ok());
+    let mut refitted = glt.clone();
+    assert!(refitted.set_light_tree(&moved.tree).is_ok());
+    // Two instances of different meshes swapped: another shape.
+    let swapped = scene_with(|instances| {
+        let (a, b) = (instances[4].mesh, instances[5].mesh);
+        instances[4].mesh = b;
+        instances[5].mesh = a;
+    });
+    assert_ne!(shape_fingerprint(&swapped.tree), shape_fingerprint(&tree));
+    assert!(matches!(
+        Glt::from_bytes(&bytes, &swapped.tree),
+        Err(LoadError::LightTreeMismatch { .. })
+    ));
+    let mut other = glt.clone();
+    assert!(other.set_light_tree(&swapped.tree).is_err());
+    // Merged with a copy over the same tree, not over the moved one.
+    let mut copy = back;
+    assert!(copy.merge(&glt));
+    assert!(!refitted.merge(&glt));
+}
+
+/// Two meshes of 40 triangles each (trees of different shapes) in two
+/// instances far apart, then with the meshes swapped: the top trees, the
+/// counts and the mesh list are the same, the flat trees' shapes are not,
+/// and neither are the fingerprints (which hash each instance's mesh);
+/// state saved over one does not load over the other.
+#[test]
+fn the_shape_binds_each_instance_to_its_mesh() {
+    let mut r = Rand::new(80);
+    let meshes = [mesh(40, &mut r), mesh(40, &mut r)];
+    let build = |first: u32| {
+        let trees = meshes
+            .iter()
+            .map(|m| {
+                let local = emitters(m, &Instance::new(0, Affine3A::IDENTITY));
+                LightTree::build(local.as_slice(), BuildHeuristic::Sarh).unwrap()
+            })
+            .collect();
+        let placed = [
+            Instance::new(first, Affine3A::from_translation(Vec3::X * -20.0)),
+            Instance::new(1 - first, Affine3A::from_translation(Vec3::X * 20.0)),
+        ];
+        InstancedLightTree::build(trees, &placed, BuildHeuristic::Sarh).unwrap()
+    };
+    let (a, b) = (build(0), build(1));
+    assert_eq!(shape_fingerprint(a.top()), shape_fingerprint(b.top()));
+    assert_eq!(a.node_count(), b.node_count());
+    let differs = (0..a.node_count() as u32).any(|n| a.children(n) != b.children(n));
+    assert!(differs, "the meshes' trees have the same shape: no test");
+    assert_ne!(shape_fingerprint(&a), shape_fingerprint(&b));
+    let bounds = Aabb::new(Vec3::splat(-30.0), Vec3::splat(30.0));
+    let glt = Glt::new(&a, bounds, GltConfig::default()).unwrap();
+    assert!(Glt::from_bytes(&glt.to_bytes(), &b).is_err());
+    assert!(glt.clone().set_light_tree(&b).is_err());
 }
 
 #[test]

@@ -209,8 +209,20 @@ pub(crate) fn read_fingerprint<H: LightHierarchy + ?Sized>(
 /// sets, in node order. Equal
 /// hierarchies (the same lights built the same way) have equal
 /// fingerprints; before format version 4, learned state was only loaded
-/// against its own (now: [`shape_fingerprint`]).
+/// against its own (now: [`shape_fingerprint`]). For an
+/// [`InstancedLightTree`](super::InstancedLightTree), FNV-1a 64 over its
+/// parts: its counts, the fingerprints of its top tree and meshes, each
+/// instance's mesh, transform and power scale (O(top and mesh nodes +
+/// instances)).
 pub fn fingerprint<H: LightHierarchy + ?Sized>(tree: &H) -> u64 {
+    if let Some(inst) = tree.as_instanced() {
+        return inst.hash_parts(fingerprint, |h, p| {
+            let m = p.transform.to_cols_array();
+            for x in m.into_iter().chain([p.power_scale]) {
+                h.u32(x.to_bits());
+            }
+        });
+    }
     hash_nodes(tree, |h, i| {
         let b = tree.node_bounds(i);
         h.u32(b.power.to_bits());

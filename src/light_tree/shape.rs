@@ -8,12 +8,18 @@ use super::LightHierarchy;
 /// True when `a` and `b` have the same shape: the same node count and
 /// emitter count, the same children at every node and the same emitter at
 /// every leaf. A tree and its refits ([`LightTree::refit`](super::LightTree::refit))
-/// have; a tree rebuilt from moved lights usually has not. O(nodes).
+/// have; a tree rebuilt from moved lights usually has not. O(nodes); for
+/// two [`InstancedLightTree`](super::InstancedLightTree)s, O(top and mesh
+/// nodes + instances): the same top tree and mesh shapes and the same mesh
+/// in every instance.
 pub(crate) fn same_shape<A, B>(a: &A, b: &B) -> bool
 where
     A: LightHierarchy + ?Sized,
     B: LightHierarchy + ?Sized,
 {
+    if let (Some(a), Some(b)) = (a.as_instanced(), b.as_instanced()) {
+        return a.same_shape_as(b);
+    }
     a.node_count() == b.node_count()
         && a.emitter_count() == b.emitter_count()
         && (0..a.node_count() as u32)
@@ -24,7 +30,17 @@ where
 /// emitter counts, then every node's children and emitter, in node order.
 /// Equal for a tree and its refits; what a saved GLT or field binds to
 /// (format version 4 on).
+///
+/// For an [`InstancedLightTree`](super::InstancedLightTree), FNV-1a 64 over
+/// its parts instead (its counts, the shape fingerprints of its top tree
+/// and meshes, each instance's mesh), which fix the shape of the flat tree
+/// it stands for: O(top and mesh nodes + instances), not O(placed
+/// triangles). So state saved over an instanced tree loads over an
+/// instanced tree of the same shape, not over a flat tree.
 pub fn shape_fingerprint<H: LightHierarchy + ?Sized>(tree: &H) -> u64 {
+    if let Some(inst) = tree.as_instanced() {
+        return inst.hash_parts(shape_fingerprint, |_, _| {});
+    }
     hash_nodes(tree, |_, _| {})
 }
 
