@@ -8,6 +8,7 @@
 
 use glam::{Affine3A, Quat, Vec3};
 use guiding::cut::CutConfig;
+use guiding::field::{FieldConfig, GuidingField};
 use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::{ImportanceTreeSampler, PowerTreeSampler};
 use guiding::light_tree::{BuildHeuristic, fingerprint, shape_fingerprint};
@@ -378,6 +379,9 @@ fn the_glts_tables_grow_with_meshes_not_placed_triangles() {
     let world = Glt::new(Flattened(&tree), bounds, GltConfig::default()).unwrap();
     let (s, w) = (shared.memory().shared_bytes, world.memory().shared_bytes);
     assert!(20 * s < w, "{s} bytes shared vs {w} over every node");
+    // The guiding field's cuts share the same tables.
+    let field = GuidingField::new(&tree, bounds, FieldConfig::default()).unwrap();
+    assert_eq!(field.memory().shared_bytes, s);
 }
 
 /// A GLT over instances is saved, loaded, refitted and merged by the
