@@ -13,6 +13,7 @@
 //!
 //! ```text
 //! cargo run --release --example instancing
+//! ROW=3 cargo run --release --example instancing   # one row of the table
 //! ```
 
 use glam::{Affine3A, Quat, Vec3};
@@ -107,21 +108,47 @@ fn main() {
          importance sampling, then the GLT trained alike\n"
     );
     println!(
-        "| instances | triangles each | spread | BVH flat | BVH instanced | instanced / flat | GLT flat | GLT instanced | instanced / flat |"
+        "| instances | triangles each | mesh, placement | spread | BVH flat | BVH instanced | instanced / flat | GLT flat | GLT instanced | instanced / flat |"
     );
-    println!("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
-    for (count, triangles, spread) in [(200, 500, 50.0), (200, 500, 200.0), (1000, 100, 50.0)] {
+    println!("| ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    let rows = [
+        (200, 500, false, 50.0),
+        (200, 500, false, 200.0),
+        (1000, 100, false, 50.0),
+        (200, 500, true, 50.0),
+    ];
+    let only: Option<usize> = std::env::var("ROW").ok().and_then(|v| v.parse().ok());
+    for (row, (count, triangles, panels, spread)) in rows.into_iter().enumerate() {
+        if only.is_some_and(|o| o != row) {
+            continue;
+        }
         let mut r = Rand::new(3);
+        // Scattered small triangles facing every way, or a lamp panel: a
+        // flat grid of triangles facing +z (one tight cone).
         let mesh: Vec<[Vec3; 3]> = (0..triangles)
-            .map(|_| {
-                let c = r.point(1.0);
-                [c, c + r.dir() * 0.05, c + r.dir() * 0.05]
+            .map(|i| match panels {
+                false => {
+                    let c = r.point(1.0);
+                    [c, c + r.dir() * 0.05, c + r.dir() * 0.05]
+                }
+                true => {
+                    let c = Vec3::new(
+                        (i % 25) as f32 * 0.08 - 1.0,
+                        (i / 25) as f32 * 0.1 - 1.0,
+                        0.0,
+                    );
+                    [c, c + Vec3::X * 0.07, c + Vec3::Y * 0.09]
+                }
             })
             .collect();
         let instances: Vec<Instance> = (0..count)
             .map(|_| {
                 let turn = Quat::from_axis_angle(r.dir(), r.range(0.0, 6.0));
-                let scale = Vec3::splat(r.range(0.5, 2.0));
+                // Panels stretched: a non-uniform scale (no angle kept).
+                let scale = match panels {
+                    false => Vec3::splat(r.range(0.5, 2.0)),
+                    true => Vec3::new(r.range(0.5, 3.0), r.range(0.5, 3.0), r.range(0.5, 3.0)),
+                };
                 let t = Affine3A::from_scale_rotation_translation(scale, turn, r.point(spread));
                 Instance::new(0, t)
             })
@@ -169,8 +196,12 @@ fn main() {
             .collect();
         let (bf, bi, br) = summary(&v);
         let (gf, gi, gr) = summary(&g);
+        let kind = match panels {
+            false => "scattered, turned and scaled",
+            true => "panel, turned and stretched",
+        };
         println!(
-            "| {count} | {triangles} | {spread} | {bf:.3} | {bi:.3} | {br:.2} | {gf:.3} | {gi:.3} | {gr:.2} |"
+            "| {count} | {triangles} | {kind} | {spread} | {bf:.3} | {bi:.3} | {br:.2} | {gf:.3} | {gi:.3} | {gr:.2} |"
         );
     }
 }

@@ -123,6 +123,16 @@ fn it_names_every_emitter_once_and_bounds_what_is_below() {
                 grown.contains(e.bounds.min) && grown.contains(e.bounds.max),
                 "node {n} does not bound emitter {i}"
             );
+            // Its normal lies in the node's normal cone (turned, mirrored
+            // or stretched with the instance).
+            if let (Some(c), true) = (e.cone, b.cone.cos_theta_o > -1.0) {
+                let angle = c.axis.angle_between(b.cone.axis);
+                let bound = b.cone.cos_theta_o.clamp(-1.0, 1.0).acos();
+                assert!(
+                    angle <= bound + 1e-4,
+                    "node {n}: emitter {i}'s normal {angle} off, bound {bound}"
+                );
+            }
             node = tree.parent(n);
         }
     }

@@ -143,7 +143,7 @@ impl<H: LightHierarchy> CutRules<H> {
 
     /// Heap bytes of the tables (about 12 per light-tree node, 44 when a
     /// rule uses importance; over an instanced tree, per node of its top
-    /// tree and meshes, plus about 120 per instance).
+    /// tree and meshes, plus 128 per instance).
     pub fn bytes(&self) -> usize {
         self.tables.bytes() + self.instanced.as_ref().map_or(0, InstancedTables::bytes)
     }

@@ -14,7 +14,12 @@
 //! direction possible, as the world-space bounds have it), which keeps
 //! the bound conservative: the distance it divides by is the mesh-space
 //! one, a weight only, and the tangent-plane test is exact under any
-//! affine map.
+//! affine map. (For triangles the mesh-space cones would be exact there
+//! too, a front/back test being a half-space test; reading them instead
+//! was measured on stretched lamp panels, `examples/instancing.rs` row 3:
+//! the typical point's variance 0.99x the flat tree's without cones,
+//! 1.03x with them, so not kept; and a spot's cone stretched is no
+//! cone.)
 
 use super::importance_table::{FastQuery, ImportanceTable};
 use super::tables::{Segment, TreeTables};
