@@ -292,14 +292,10 @@ impl InstancedLightTree {
         h.bytes(b"instanced");
         h.u32(self.node_count);
         h.u32(self.emitter_count);
-        let u64 = |h: &mut Fnv, x: u64| {
-            h.u32(x as u32);
-            h.u32((x >> 32) as u32);
-        };
-        u64(&mut h, tree(&self.top));
+        h.u64(tree(&self.top));
         h.u32(self.meshes.len() as u32);
         for mesh in &self.meshes {
-            u64(&mut h, tree(mesh));
+            h.u64(tree(mesh));
         }
         h.u32(self.instances.len() as u32);
         for p in &self.instances {

@@ -34,6 +34,10 @@ impl Fnv {
         self.bytes(&x.to_le_bytes());
     }
 
+    pub(crate) fn u64(&mut self, x: u64) {
+        self.bytes(&x.to_le_bytes());
+    }
+
     pub(crate) fn finish(&self) -> u64 {
         self.0
     }
