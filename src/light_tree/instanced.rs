@@ -407,13 +407,13 @@ fn place(inst: &Instance, node_base: u32, emitter_base: u32) -> Placed {
 
 /// The condition number of `m`: `sqrt(lambda_max / lambda_min)` of its
 /// Gram matrix `m^T m`, formed and solved in closed form (Smith's method)
-/// in `f64`, rounded up by 1e-4 of itself; infinite when `m` is singular
-/// or not finite.
+/// in `f64`, rounded up by 1e-4 of itself (more than the eigenvalues'
+/// rounding wherever it matters: a cone stretched by more than 3e4 is the
+/// whole sphere anyway); infinite when `m` is singular or not finite.
 fn condition_number(m: glam::Mat3) -> f32 {
     let cols = [m.x_axis, m.y_axis, m.z_axis].map(|c| c.to_array().map(f64::from));
-    let dot = |i: usize, j: usize| (0..3).map(|k| cols[i][k] * cols[j][k]).sum::<f64>();
     // The Gram matrix's entry (r, c): column r dotted with column c.
-    let a = |r: usize, c: usize| dot(r, c);
+    let a = |r: usize, c: usize| (0..3).map(|k| cols[r][k] * cols[c][k]).sum::<f64>();
     let off = a(0, 1) * a(0, 1) + a(0, 2) * a(0, 2) + a(1, 2) * a(1, 2);
     let diag = [a(0, 0), a(1, 1), a(2, 2)];
     let (lo, hi) = if off == 0.0 {
