@@ -173,7 +173,8 @@ impl<H: LightHierarchy> CutRules<H> {
 
     /// Where a walk at `node` of `seg` goes on when `node` is the top
     /// tree's leaf of an instance: its mesh's root, in its mesh's tables.
-    /// `None` anywhere else (the walk stays where it is).
+    /// `None` anywhere else (the walk stays where it is): inside an
+    /// instance, and at inner nodes, which name no emitter.
     #[inline(always)]
     pub(crate) fn enter<'a>(
         &'a self,
@@ -181,7 +182,7 @@ impl<H: LightHierarchy> CutRules<H> {
         node: WalkNode,
     ) -> Option<(Segment<'a>, WalkNode)> {
         let (tables, _) = self.instanced()?;
-        if seg.instance.is_some() || node.children().is_some() {
+        if seg.instance.is_some() {
             return None;
         }
         let inner = tables.segment(node.emitter()?, &seg.fast)?;
