@@ -22,15 +22,14 @@ use guiding::light_sampler::ImportanceTreeSampler;
 use guiding::light_tree::{BuildHeuristic, shape_fingerprint};
 use guiding::math::Aabb;
 use guiding::{
-    Emitter, Instance, InstancedLightTree, LightHierarchy, LightId, LightSampler, LightTree,
-    ShadingContext,
+    Emitter, Instance, InstancedLightTree, LightHierarchy, LightSampler, LightTree, ShadingContext,
 };
 use std::hint::black_box;
 use std::time::Duration;
 
 #[path = "../tests/common/mod.rs"]
 mod common;
-use common::{Flattened, Rand, contribution, mixed_scene};
+use common::{Flattened, Rand, mixed_scene, train_on_own_choices};
 
 const HEURISTICS: [BuildHeuristic; 4] = [
     BuildHeuristic::Balanced,
@@ -264,25 +263,8 @@ fn instanced(c: &mut Criterion) {
 /// chooses at a random point on a random surface, over its pmf.
 fn trained<H: LightHierarchy>(tree: H, lights: &[Emitter], scene: Aabb) -> Glt<H> {
     let mut glt = Glt::new(tree, scene, GltConfig::default()).expect("valid configuration");
-    let mut r = Rand::new(10);
-    for _ in 0..3 {
-        for _ in 0..20_000 {
-            // A renderer's record: a light chosen by the guide itself at a
-            // point on a surface, its unshadowed contribution over its pmf.
-            let ctx = ShadingContext::on_surface(r.point(scene.max.x - 2.0), r.dir());
-            let Some(vertex) = glt.vertex(&ctx) else {
-                continue;
-            };
-            if let Some(s) = vertex.sample(&ctx, r.f()) {
-                let LightId::Emitter(e) = s.light else {
-                    continue;
-                };
-                let v = contribution(&lights[e as usize], ctx.position) / f64::from(s.pmf);
-                vertex.record_light(s.light, v as f32);
-            }
-        }
-        glt.refine();
-    }
+    let half = scene.max.x - 2.0;
+    train_on_own_choices(&mut glt, lights, half, (3, 20_000), &mut Rand::new(10));
     glt
 }
 

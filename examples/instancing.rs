@@ -29,7 +29,7 @@ use rayon::prelude::*;
 
 #[path = "../tests/common/mod.rs"]
 mod common;
-use common::{Rand, contribution};
+use common::{Rand, contribution, train_on_own_choices};
 
 const POINTS: usize = 200;
 
@@ -65,25 +65,7 @@ fn variance(s: &dyn LightSampler, lights: &[Emitter], ctx: &ShadingContext) -> f
 fn trained<H: LightHierarchy>(tree: H, lights: &[Emitter], spread: f32) -> Glt<H> {
     let scene = Aabb::new(Vec3::splat(-spread - 2.0), Vec3::splat(spread + 2.0));
     let mut glt = Glt::new(tree, scene, GltConfig::default()).unwrap();
-    let mut r = Rand::new(11);
-    for _ in 0..4 {
-        for _ in 0..50_000 {
-            // A renderer's record: a light chosen by the guide itself at a
-            // point on a surface, its unshadowed contribution over its pmf.
-            let ctx = ShadingContext::on_surface(r.point(spread), r.dir());
-            let Some(vertex) = glt.vertex(&ctx) else {
-                continue;
-            };
-            if let Some(s) = vertex.sample(&ctx, r.f()) {
-                let LightId::Emitter(e) = s.light else {
-                    continue;
-                };
-                let v = contribution(&lights[e as usize], ctx.position) / f64::from(s.pmf);
-                vertex.record_light(s.light, v as f32);
-            }
-        }
-        glt.refine();
-    }
+    train_on_own_choices(&mut glt, lights, spread, (4, 50_000), &mut Rand::new(11));
     glt
 }
 

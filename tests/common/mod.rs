@@ -8,8 +8,8 @@
 #![allow(dead_code)]
 
 use glam::Vec3;
-use guiding::Emitter;
 use guiding::math::{Aabb, LightCone};
+use guiding::{Emitter, LightSampler};
 use rand_pcg::Pcg64Mcg;
 use rand_pcg::rand_core::{Rng, SeedableRng};
 
@@ -345,6 +345,35 @@ pub fn chi_square_z(observed: &[u64], probs: &[f64]) -> Option<(f64, usize)> {
     let v = 2.0 / (9.0 * k);
     let z = ((chi2 / k).cbrt() - (1.0 - v)) / v.sqrt();
     Some((z, kept.len() - 1))
+}
+
+/// Trains `glt` as a renderer trains it, without shadows: `rounds` rounds
+/// of `records` records, each the contribution ([`contribution`]) of a
+/// light the GLT chooses at a random point within `half` of the origin on
+/// a random surface, over its pmf; a refinement after each round.
+pub fn train_on_own_choices<H: guiding::LightHierarchy>(
+    glt: &mut guiding::glt::Glt<H>,
+    lights: &[Emitter],
+    half: f32,
+    (rounds, records): (usize, usize),
+    r: &mut Rand,
+) {
+    for _ in 0..rounds {
+        for _ in 0..records {
+            let ctx = guiding::ShadingContext::on_surface(r.point(half), r.dir());
+            let Some(vertex) = glt.vertex(&ctx) else {
+                continue;
+            };
+            if let Some(s) = vertex.sample(&ctx, r.f()) {
+                let guiding::LightId::Emitter(e) = s.light else {
+                    continue;
+                };
+                let v = contribution(&lights[e as usize], ctx.position) / f64::from(s.pmf);
+                vertex.record_light(s.light, v as f32);
+            }
+        }
+        glt.refine();
+    }
 }
 
 mod at_point;
