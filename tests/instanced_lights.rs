@@ -47,6 +47,12 @@ fn emitters(triangles: &[Triangle], inst: &Instance) -> Vec<Emitter> {
         .collect()
 }
 
+/// A mesh's tree, built in mesh space.
+fn mesh_tree(triangles: &[Triangle]) -> LightTree {
+    let local = emitters(triangles, &Instance::new(0, Affine3A::IDENTITY));
+    LightTree::build(local.as_slice(), BuildHeuristic::Sarh).unwrap()
+}
+
 struct Scene {
     tree: InstancedLightTree,
     /// The same lights flat in world space, in the instanced tree's
@@ -65,13 +71,7 @@ fn scene() -> Scene {
 fn scene_with(change: impl Fn(&mut Vec<Instance>)) -> Scene {
     let mut r = Rand::new(71);
     let meshes: Vec<Vec<Triangle>> = [40, 1, 0].map(|n| mesh(n, &mut r)).into();
-    let trees: Vec<LightTree> = meshes
-        .iter()
-        .map(|m| {
-            let local = emitters(m, &Instance::new(0, Affine3A::IDENTITY));
-            LightTree::build(local.as_slice(), BuildHeuristic::Sarh).unwrap()
-        })
-        .collect();
+    let trees: Vec<LightTree> = meshes.iter().map(|m| mesh_tree(m)).collect();
     let mut instances = Vec::new();
     for i in 0..12 {
         let at = Vec3::new(
@@ -298,8 +298,7 @@ fn the_glt_learns_inside_instances() {
 fn per_mesh_tables_choose_as_world_tables_do() {
     let mut r = Rand::new(77);
     let triangles = mesh(40, &mut r);
-    let local = emitters(&triangles, &Instance::new(0, Affine3A::IDENTITY));
-    let mesh_tree = LightTree::build(local.as_slice(), BuildHeuristic::Sarh).unwrap();
+    let mesh_tree = mesh_tree(&triangles);
     let quarter = core::f32::consts::FRAC_PI_2;
     let instances: Vec<Instance> = (0..10)
         .map(|i| {
@@ -377,8 +376,7 @@ fn per_mesh_tables_choose_as_world_tables_do() {
 fn the_glts_tables_grow_with_meshes_not_placed_triangles() {
     let mut r = Rand::new(78);
     let triangles = mesh(500, &mut r);
-    let local = emitters(&triangles, &Instance::new(0, Affine3A::IDENTITY));
-    let mesh_tree = LightTree::build(local.as_slice(), BuildHeuristic::Sarh).unwrap();
+    let mesh_tree = mesh_tree(&triangles);
     let instances: Vec<Instance> = (0..200)
         .map(|i| Instance::new(0, Affine3A::from_translation(Vec3::X * i as f32 * 3.0)))
         .collect();
@@ -458,13 +456,7 @@ fn the_shape_binds_each_instance_to_its_mesh() {
     let mut r = Rand::new(80);
     let meshes = [mesh(40, &mut r), mesh(40, &mut r)];
     let build = |first: u32| {
-        let trees = meshes
-            .iter()
-            .map(|m| {
-                let local = emitters(m, &Instance::new(0, Affine3A::IDENTITY));
-                LightTree::build(local.as_slice(), BuildHeuristic::Sarh).unwrap()
-            })
-            .collect();
+        let trees = meshes.iter().map(|m| mesh_tree(m)).collect();
         let placed = [
             Instance::new(first, Affine3A::from_translation(Vec3::X * -20.0)),
             Instance::new(1 - first, Affine3A::from_translation(Vec3::X * 20.0)),
@@ -486,8 +478,8 @@ fn the_shape_binds_each_instance_to_its_mesh() {
 #[test]
 fn bad_instances_are_typed_errors() {
     let mut r = Rand::new(75);
-    let lights = emitters(&mesh(5, &mut r), &Instance::new(0, Affine3A::IDENTITY));
-    let meshes = || vec![LightTree::build(lights.as_slice(), BuildHeuristic::Sarh).unwrap()];
+    let triangles = mesh(5, &mut r);
+    let meshes = || vec![mesh_tree(&triangles)];
     let ok = Instance::new(0, Affine3A::IDENTITY);
     let cases = [
         Instance { mesh: 1, ..ok },
