@@ -26,7 +26,10 @@
 //!   combination), [`SharedGuide`] (render threads sharing a guide that any
 //!   of them refines);
 //! - errors: [`Error`], [`ConfigError`], [`LoadError`], and the
-//!   [`DroppedRecords`] count of bad input.
+//!   [`DroppedRecords`] count of bad input;
+//! - on a GPU: [`Glt::snapshot`] gives what a GLT learned as plain-data
+//!   arrays ([`snapshot::Snapshot`], the one public module), with the
+//!   sampling rule over them on the CPU; `gpu/` samples them in WGSL.
 //!
 //! Each guide owns (or shares, or borrows) its light tree; constructors
 //! validate their configuration. The `inspect` feature makes every module
@@ -43,7 +46,9 @@
 //! `light_tree`, `spatial` (PPG's binary tree), `error`, `record` and
 //! `dropped` (what records answer and count), `light_sampler`, `quadtree`
 //! and `sd_tree`, `cut` (the learned cut, its sampling rule, records and
-//! refinement), `glt` and `field` (cuts in spatial trees), `schedule`, then
+//! refinement), `snapshot` (a trained guide's cuts as plain arrays for GPU
+//! kernels, and the sampling rule over them in `f32`), `glt` and `field`
+//! (cuts in spatial trees), `schedule`, then
 //! for the integrator `strategy`, `path_recorder`, `mis`, `resampling` and
 //! `shared_guide`.
 //!
@@ -70,6 +75,8 @@
 //! | the importance of a light cluster | `src/light_sampler/importance.rs` |
 //! | the same, from decoded nodes in `f32` (the GLT's importance rules) | `src/cut/importance_table.rs` |
 //! | the one-number descent | `src/math/descent.rs` |
+//! | a trained GLT as plain arrays for GPU kernels (`Glt::snapshot`), their layout | `src/snapshot/build.rs`, `src/snapshot/layout.rs` |
+//! | the GLT's sampling rule in `f32` over those arrays (the WGSL kernel's twin: `gpu/src/sample.wgsl`) | `src/snapshot/sampling.rs`, `src/snapshot/importance.rs` |
 //! | quadtree sampling and pdf | `src/quadtree/query.rs` |
 //!
 //! ## Contracts
@@ -179,6 +186,11 @@ macro_rules! inspect_tier {
         )*
     };
 }
+
+// A trained guide's light choice as plain-data arrays for GPU kernels,
+// and its sampling rule over them: always public (a renderer's GPU path
+// needs the layout).
+pub mod snapshot;
 
 inspect_tier! {
     cut;

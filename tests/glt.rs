@@ -9,13 +9,14 @@ use guiding::cut::{
     BelowCut, CutConfig, CutNode, CutRules, GuidingCut, Modulation, Prior, Slot, SplitPrior,
 };
 use guiding::light_tree::{BuildHeuristic, EmitterPath, NodeBounds};
-use guiding::math::{Aabb, Accumulation, LightCone, Side};
+use guiding::math::{Aabb, Accumulation, Side};
 use guiding::{
     Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext, UnboundedLights,
 };
 use proptest::prelude::*;
 
 mod common;
+use common::Chain;
 use common::LightsAt;
 use common::Rand;
 use guiding::RecordOutcome;
@@ -681,90 +682,6 @@ fn estimate_is_unbiased_with_the_defensive_mixture() {
 // ---------------------------------------------------------------------------
 // Numerical stability
 // ---------------------------------------------------------------------------
-
-/// A caterpillar hierarchy: inner node `k` has leaf `k` on the left and the
-/// rest of the chain on the right, so leaf `k` sits at depth `k + 1` (the
-/// last two at depth `n - 1`). Inner `k` = node `2k`, leaf `k` = node
-/// `2k + 1`, the last leaf is node `2n - 2`.
-struct Chain {
-    power: Vec<f32>,
-    subtree: Vec<f32>,
-}
-
-impl Chain {
-    fn new(power: Vec<f32>) -> Self {
-        let n = power.len();
-        let mut subtree = vec![0.0f32; n];
-        let mut acc = 0.0f64;
-        for k in (0..n).rev() {
-            acc += power[k] as f64;
-            subtree[k] = acc as f32;
-        }
-        Self { power, subtree }
-    }
-    fn n(&self) -> u32 {
-        self.power.len() as u32
-    }
-    fn leaf_node(&self, e: u32) -> u32 {
-        if e == self.n() - 1 { 2 * e } else { 2 * e + 1 }
-    }
-}
-
-impl LightHierarchy for Chain {
-    fn root(&self) -> Option<u32> {
-        Some(0)
-    }
-    fn children(&self, node: u32) -> Option<[u32; 2]> {
-        let n = self.n();
-        if node % 2 == 1 || node == 2 * n - 2 {
-            return None;
-        }
-        let k = node / 2;
-        Some([2 * k + 1, 2 * k + 2])
-    }
-    fn parent(&self, node: u32) -> Option<u32> {
-        if node == 0 {
-            None
-        } else if node % 2 == 1 {
-            Some(node - 1)
-        } else {
-            Some(node - 2)
-        }
-    }
-    fn power(&self, node: u32) -> f32 {
-        match self.emitter(node) {
-            Some(e) => self.power[e as usize],
-            None => self.subtree[(node / 2) as usize],
-        }
-    }
-    fn node_bounds(&self, node: u32) -> NodeBounds {
-        NodeBounds {
-            bounds: Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0)),
-            cone: LightCone::SPHERE,
-            two_sided: false,
-            power: self.power(node),
-        }
-    }
-    fn emitter(&self, node: u32) -> Option<u32> {
-        let n = self.n();
-        if node == 2 * n - 2 {
-            Some(n - 1)
-        } else if node % 2 == 1 {
-            Some(node / 2)
-        } else {
-            None
-        }
-    }
-    fn leaf(&self, emitter: u32) -> Option<u32> {
-        (emitter < self.n()).then(|| self.leaf_node(emitter))
-    }
-    fn node_count(&self) -> usize {
-        2 * self.power.len() - 1
-    }
-    fn emitter_count(&self) -> usize {
-        self.power.len()
-    }
-}
 
 /// A chain whose leaf of emitter `hole` names no emitter: a custom
 /// hierarchy may have such a leaf.

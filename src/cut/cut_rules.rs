@@ -148,6 +148,12 @@ impl<H: LightHierarchy> CutRules<H> {
         self.tables.bytes() + self.instanced.as_ref().map_or(0, InstancedTables::bytes)
     }
 
+    /// The tables of the hierarchy (of the top tree of an instanced one).
+    #[inline]
+    pub(crate) fn tables(&self) -> &TreeTables {
+        &self.tables
+    }
+
     /// The tables at the root, seeing the point as `fast`.
     #[inline(always)]
     pub(crate) fn top_segment(&self, fast: FastQuery) -> Segment<'_> {

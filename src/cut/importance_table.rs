@@ -229,6 +229,18 @@ impl ImportanceTable {
         Self { pairs }
     }
 
+    /// The two entries of walk-table pair `pair` as stored (32 bytes each:
+    /// centre, squared radius, 16-bit axis, flags, two bfloat16 cone
+    /// terms, power), for the GPU snapshot, which declares the same record.
+    pub(crate) fn entry_bytes(&self, pair: usize) -> Option<[[u8; 32]; 2]> {
+        let Pair(entries) = self.pairs.get(pair)?;
+        Some(entries.map(|e| {
+            let mut bytes = [0u8; 32];
+            bytes.copy_from_slice(bytemuck::bytes_of(&e));
+            bytes
+        }))
+    }
+
     /// Bytes of the table.
     pub(crate) fn bytes(&self) -> usize {
         self.pairs.len() * core::mem::size_of::<Pair>()

@@ -73,5 +73,6 @@ pub use cut_node::{CutNode, Slot};
 pub use cut_rules::CutRules;
 pub use guiding_cut::{CutError, CutMemory, GuidingCut};
 pub(crate) use octants::OctantSplats;
+pub(crate) use tables::TreeTables;
 pub(crate) use vertex::LightCells;
 pub use vertex::LightVertex;

@@ -174,6 +174,42 @@ impl Mixture {
     }
 }
 
+/// What a GPU snapshot (`crate::snapshot`) precomputes of one cell: its
+/// [`Mixture`]'s weights and whether its cut is modulated and its prior
+/// tracked, exactly as [`Rule::new`] derives them for a point that every
+/// light may light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct CellWeights {
+    /// Probability of the unbounded lights together.
+    pub(crate) unbounded: f64,
+    /// Weight of a learned unbounded fraction.
+    pub(crate) learned: f64,
+    /// Each unbounded light's floor.
+    pub(crate) floor: f64,
+    /// Weight of the cut component.
+    pub(crate) cut: f64,
+    /// Weight of the prior component.
+    pub(crate) prior: f64,
+    /// [`Modulation::Importance`] applies to this cut.
+    pub(crate) modulate: bool,
+}
+
+impl<H: LightHierarchy> CutRules<H> {
+    /// The weights of `cut`'s mixture for the snapshot.
+    pub(crate) fn cell_weights(&self, cut: &GuidingCut) -> CellWeights {
+        let config = self.config();
+        let m = Mixture::new(self.has_power(), cut, config);
+        CellWeights {
+            unbounded: m.unbounded,
+            learned: m.learned,
+            floor: m.floor,
+            cut: m.cut,
+            prior: m.prior,
+            modulate: config.modulation == Modulation::Importance && cut.modulated,
+        }
+    }
+}
+
 /// Where a walk is: a light-tree node's walk-table entry in the walk's
 /// current [`Segment`] (which also locates its children in the importance
 /// table) and, while inside the cut, the cut node that stands for it.

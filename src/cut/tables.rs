@@ -69,6 +69,11 @@ impl TreeTables {
             + self.importance.as_ref().map_or(0, ImportanceTable::bytes)
     }
 
+    /// The walk table.
+    pub(crate) fn walk(&self) -> &WalkTable {
+        &self.walk
+    }
+
     /// The decoded importance table, when built.
     #[inline(always)]
     pub(crate) fn importance(&self) -> Option<&ImportanceTable> {

@@ -89,7 +89,7 @@ impl<H: LightHierarchy> CutRules<H> {
     /// [`GuidingCut::confidence`]: `1 - confidence (1 - v)`, so a cut that
     /// learned nothing of its own assumes nothing is hidden.
     #[inline]
-    pub(super) fn visibility_at(&self, cut: &GuidingCut, sum: Option<usize>) -> f32 {
+    pub(crate) fn visibility_at(&self, cut: &GuidingCut, sum: Option<usize>) -> f32 {
         let v = sum
             .and_then(|i| cut.visibility.get(i).copied())
             .unwrap_or(1.0);

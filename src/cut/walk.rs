@@ -46,6 +46,13 @@ impl WalkNode {
         (self.link & LEAF == 0).then_some(self.link)
     }
 
+    /// The link word: the children pair, or `1 << 31` | the emitter of a
+    /// leaf (`u32::MAX` for an unusable one).
+    #[inline(always)]
+    pub(crate) fn link(self) -> u32 {
+        self.link
+    }
+
     /// A leaf's emitter; `None` for an inner node or an unusable leaf.
     #[inline(always)]
     pub(crate) fn emitter(self) -> Option<u32> {
@@ -143,6 +150,11 @@ impl WalkTable {
             visit_pairs(tree, |_, _, _, children| nodes.push(Some(children)));
         }
         nodes
+    }
+
+    /// Every pair, pair 0 (the root's) first.
+    pub(crate) fn pairs(&self) -> &[WalkPair] {
+        &self.pairs
     }
 
     /// The root's entry; `None` for an empty tree.

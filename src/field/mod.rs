@@ -119,6 +119,7 @@ use crate::error::Error;
 use crate::light_tree::LightHierarchy;
 use crate::math::Aabb;
 use crate::sd_tree::SdState;
+use crate::snapshot::{Snapshot, SnapshotError};
 use crate::spatial::{BinaryTree, CellId, RefineOutcome, SpatialFilter, SpatialTree};
 use glam::Vec3;
 
@@ -215,6 +216,14 @@ impl<H: LightHierarchy> GuidingField<H> {
         self.guide
             .set_light_tree(lights)
             .map_err(|_| Error::LightTreeShape)
+    }
+
+    /// Every cell's learned light choice as plain-data arrays a GPU
+    /// kernel samples ([`crate::snapshot`], as
+    /// [`Glt::snapshot`](crate::Glt::snapshot)); the directional half (the SD-trees) is not
+    /// in it.
+    pub fn snapshot(&self) -> Result<Snapshot, SnapshotError> {
+        Snapshot::new(&self.guide, &self.cells)
     }
 
     /// The guiding tree every cell's cut is used through.

@@ -14,6 +14,7 @@ use crate::light_sampler::ShadingContext;
 use crate::light_tree::LightHierarchy;
 use crate::math::Aabb;
 use crate::record::RecordOutcome;
+use crate::snapshot::{Snapshot, SnapshotError};
 use crate::spatial::{BinaryTree, CellId, Located, RefineOutcome, SpatialTree};
 use crate::spatial::{Growth, content_scale};
 use glam::Vec3;
@@ -216,6 +217,15 @@ impl<H: LightHierarchy> Glt<H> {
         }
         self.iteration = self.iteration.saturating_add(1);
         outcome
+    }
+
+    /// What every cell learned, as plain-data arrays a GPU kernel samples
+    /// ([`crate::snapshot`]): the same light choice as [`Glt::vertex`]'s
+    /// up to `f32` rounding. A copy: take another after the next
+    /// [`Glt::refine`]. Errors for light sets and instanced light trees,
+    /// which a snapshot does not carry. O(cells + cut nodes + lights).
+    pub fn snapshot(&self) -> Result<Snapshot, SnapshotError> {
+        Snapshot::new(&self.guide, &self.spatial)
     }
 
     /// Bytes used, by part.

@@ -55,6 +55,15 @@ impl<T> BinaryTree<T> {
         })
     }
 
+    /// The node words, root first: an inner node's word is the index of
+    /// its first child (the second follows it), a leaf's is `1 << 31`
+    /// | its cell. Children split their parent at its midpoint on axis
+    /// x, y, z in turn from the root (the GPU snapshot copies them).
+    #[inline]
+    pub(crate) fn node_words(&self) -> &[u32] {
+        &self.nodes
+    }
+
     /// How many nodes (inner and leaf).
     #[inline]
     pub fn node_count(&self) -> usize {

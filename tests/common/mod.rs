@@ -380,6 +380,10 @@ mod at_point;
 #[allow(unused_imports)]
 pub use at_point::{ByPosition, DirectionsAt, LightsAt};
 
+mod chain;
+#[allow(unused_imports)]
+pub use chain::Chain;
+
 mod flattened;
 #[allow(unused_imports)]
 pub use flattened::Flattened;
