@@ -12,7 +12,8 @@
 //! `integrator` (the path tracer and its training records), `methods`
 //! (which crate objects a method uses), `run` (passes, training schedule,
 //! combination), `film` (EXR/PNG), `reference` (cache), `metrics`,
-//! `report` (JSON, table), `sheet` (comparison sheet), `animation` and
+//! `report` (JSON, table), `sheet` (comparison sheet), `shading_points`
+//! (the first non-specular vertices of camera paths), `animation` and
 //! `frames` (an animated scene and its frames rendered three ways).
 #![allow(missing_docs)]
 
@@ -38,6 +39,7 @@ pub mod rng;
 pub mod run;
 pub mod scene;
 pub mod scenes;
+pub mod shading_points;
 pub mod sheet;
 pub mod text;
 pub mod tiles;

@@ -8,11 +8,9 @@
 
 #[path = "../src/bin/light_limit/brute_force.rs"]
 mod brute_force;
-#[path = "../src/bin/light_limit/shading_points.rs"]
-mod shading_points;
 #[path = "../src/bin/light_limit/variance.rs"]
 mod variance;
-use guiding_render::{geometry, materials, rng, scene, scenes};
+use guiding_render::{geometry, rng, scene, scenes, shading_points};
 
 use brute_force::PointTerms;
 

@@ -31,9 +31,9 @@ mod breakdown;
 mod brute_force;
 mod glt_variant;
 mod per_point_m;
-mod shading_points;
+
 mod variance;
-use guiding_render::{geometry, materials, methods, rng, run, scene, scenes};
+use guiding_render::{geometry, methods, rng, run, scene, scenes, shading_points};
 
 use brute_force::PointTerms;
 use clap::Parser;
