@@ -1,7 +1,9 @@
 //! Microbenchmarks of the Guiding Light Tree: `sample`, `pmf` and both per
 //! call for sigma in {0.05, 0.01, 0.002} and 1e2..1e6 lights, beside
-//! tree-by-power sampling on the same tree; `splat` per call; `refine` per
-//! cell; bytes per cut node and per cell (printed).
+//! tree-by-power sampling on the same tree; a whole GLT's `sample` and
+//! `sample` + `pmf` beside its GPU snapshot's `f32` sampler on the CPU;
+//! `splat` per call; `refine` per cell; bytes per cut node and per cell
+//! (printed).
 //!
 //! Cuts are trained with synthetic splats (a fragmented visible subset with
 //! distance falloff, sampled from the cut itself as a renderer would) so they
@@ -278,6 +280,32 @@ fn bench_sampling(c: &mut Criterion) {
                         .sample(black_box(&ctx), black_box(u[i]))
                         .unwrap();
                     ByPosition(&glt).pmf(&ctx, s.light)
+                })
+            });
+            // The same queries through the GPU snapshot's f32 sampler on
+            // the CPU (src/snapshot/): the cell lookup is in each call.
+            let snapshot = glt.snapshot().unwrap();
+            let view = snapshot.view();
+            group.bench_function("snapshot/sample+pmf", |b| {
+                b.iter(|| {
+                    let i = next();
+                    let s = view
+                        .sample(black_box(points[i]), Some(Vec3::Y), black_box(u[i]))
+                        .unwrap();
+                    view.pmf(points[i], Some(Vec3::Y), s.light)
+                })
+            });
+            group.bench_function("glt/sample", |b| {
+                b.iter(|| {
+                    let i = next();
+                    let ctx = ShadingContext::on_surface(points[i], Vec3::Y);
+                    ByPosition(&glt).sample(black_box(&ctx), black_box(u[i]))
+                })
+            });
+            group.bench_function("snapshot/sample", |b| {
+                b.iter(|| {
+                    let i = next();
+                    view.sample(black_box(points[i]), Some(Vec3::Y), black_box(u[i]))
                 })
             });
             group.bench_function("power/sample+pmf-moving", |b| {
