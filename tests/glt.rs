@@ -757,8 +757,8 @@ fn a_leaf_without_an_emitter_is_never_chosen() {
 /// paper's code, never reaches leaves past depth ~24 and fails this.)
 #[test]
 fn deep_chain_is_exact_in_distribution() {
-    let n = 100u32;
-    let chain = Chain::new((0..n).map(|k| 1.0 + ((k * 7) % 5) as f32).collect());
+    let chain = Chain::deep();
+    let n = chain.n();
     for (below_cut, split_prior) in ALL_CONFIGS {
         let config = CutConfig {
             below_cut,
@@ -767,17 +767,9 @@ fn deep_chain_is_exact_in_distribution() {
         };
         let guide = CutRules::new(&chain, config).unwrap();
         let mut cut = guide.new_cut();
-        // Learned targets: large for k < 70 (skewed), small tail whose total
-        // share (< sigma) ends the cut at depth 70. Fresh half splits reach
-        // a few levels deeper per pass, power splits all the way.
         for _ in 0..16 {
             for k in 0..n {
-                let t = if k < 70 {
-                    1.0 + ((k * 3) % 7) as f32
-                } else {
-                    0.05
-                };
-                guide.splat(&cut, LightId::Emitter(k), t);
+                guide.splat(&cut, LightId::Emitter(k), Chain::deep_target(k));
             }
             guide.refine(&mut cut);
         }

@@ -17,7 +17,7 @@ use glam::{Mat3A, Vec3, Vec3A};
 /// cones: `f32` rounding must never decide that a cluster cannot reach a
 /// point that the exact bound says it reaches (the importance is then 0
 /// and, with an importance prior, so is the pmf).
-const COS_SLACK: f32 = 1e-4;
+pub(crate) const COS_SLACK: f32 = 1e-4;
 
 /// The angle by which stored normal cones are widened, covering the error
 /// of the 16-bit axis (at most ~3e-5 rad) with margin.
@@ -68,7 +68,7 @@ fn bf16_up(x: f32) -> u16 {
 }
 
 #[inline(always)]
-fn from_bf16(b: u16) -> f32 {
+pub(crate) fn from_bf16(b: u16) -> f32 {
     f32::from_bits(u32::from(b) << 16)
 }
 
@@ -78,7 +78,7 @@ fn snorm(c: f32) -> i16 {
 }
 
 #[inline(always)]
-fn decode(q: i16) -> f32 {
+pub(crate) fn decode(q: i16) -> f32 {
     q as f32 * (1.0 / SNORM)
 }
 
@@ -180,13 +180,13 @@ impl FastQuery {
 }
 
 #[inline(always)]
-fn sin_of(cos: f32) -> f32 {
+pub(crate) fn sin_of(cos: f32) -> f32 {
     sqrt((1.0 - cos * cos).max(0.0))
 }
 
 /// `cos(max(0, a - b))` from the sines and cosines of `a` and `b`.
 #[inline(always)]
-fn cos_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
+pub(crate) fn cos_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
     if cos_a > cos_b {
         1.0
     } else {
@@ -196,7 +196,7 @@ fn cos_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
 
 /// `sin(max(0, a - b))` from the sines and cosines of `a` and `b`.
 #[inline(always)]
-fn sin_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
+pub(crate) fn sin_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
     if cos_a > cos_b {
         0.0
     } else {

@@ -74,5 +74,10 @@ pub use cut_rules::CutRules;
 pub use guiding_cut::{CutError, CutMemory, GuidingCut};
 pub(crate) use octants::OctantSplats;
 pub(crate) use tables::TreeTables;
+// The f32 cone arithmetic of the decoded bounds, shared with the GPU
+// snapshot's importance (`src/snapshot/importance.rs`).
+pub(crate) use importance_table::{
+    COS_SLACK, cos_sub_clamped, decode, from_bf16, sin_of, sin_sub_clamped,
+};
 pub(crate) use vertex::LightCells;
 pub use vertex::LightVertex;

@@ -7,18 +7,14 @@
 //! ratio between two siblings is ever read, so each importance is kept as
 //! a numerator and a squared distance and the pair is cross-multiplied
 //! after scaling both distances by the larger: every product stays in
-//! `[0, 1]`. The WGSL kernel (`gpu/src/sample.wgsl`) is this file line for
-//! line.
+//! `[0, 1]`. The cone arithmetic (`cos_sub_clamped` and its kin, the
+//! bfloat16 and 16-bit decoding) is the CPU table's own. The WGSL kernel
+//! (`gpu/src/sample.wgsl`) is this file line for line.
 
 use super::layout::{Bounds, BoundsPair, OMNI, TWO_SIDED};
+use crate::cut::{COS_SLACK, cos_sub_clamped, decode, from_bf16, sin_of, sin_sub_clamped};
+use crate::light_sampler::BACK_FACTOR;
 use crate::math::scalar::sqrt;
-
-/// Slack on the emission-angle test (as the CPU table's).
-const COS_SLACK: f32 = 1e-4;
-
-/// The back-facing floor of the emission cosine (the crate's
-/// `BACK_FACTOR`, 1e-3).
-const BACK: f32 = 1e-3;
 
 /// A shading point as the importance reads it.
 #[derive(Clone, Copy, Debug)]
@@ -43,41 +39,6 @@ impl Point {
 #[inline(always)]
 fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-#[inline(always)]
-fn from_bf16(b: u16) -> f32 {
-    f32::from_bits(u32::from(b) << 16)
-}
-
-#[inline(always)]
-fn decode(q: i16) -> f32 {
-    q as f32 * (1.0 / 32767.0)
-}
-
-#[inline(always)]
-fn sin_of(cos: f32) -> f32 {
-    sqrt((1.0 - cos * cos).max(0.0))
-}
-
-/// `cos(max(0, a - b))` from the sines and cosines of `a` and `b`.
-#[inline(always)]
-fn cos_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
-    if cos_a > cos_b {
-        1.0
-    } else {
-        cos_a * cos_b + sin_a * sin_b
-    }
-}
-
-/// `sin(max(0, a - b))` from the sines and cosines of `a` and `b`.
-#[inline(always)]
-fn sin_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
-    if cos_a > cos_b {
-        0.0
-    } else {
-        sin_a * cos_b - cos_a * sin_b
-    }
 }
 
 /// The importance of `e` at `q` as `(numerator, squared distance)`: the
@@ -125,7 +86,7 @@ fn importance(q: &Point, e: &Bounds) -> (f32, f32) {
     if !reaches {
         return (0.0, 1.0);
     }
-    let mut a = e.power * cos_thetap.max(BACK);
+    let mut a = e.power * cos_thetap.max(BACK_FACTOR as f32);
     if let Some(n) = q.n {
         let cos_i = dot(wi, n).abs().min(1.0);
         a *= cos_sub_clamped(sin_of(cos_i), cos_i, sin_b, cos_b).max(0.0);

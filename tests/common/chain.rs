@@ -27,6 +27,24 @@ impl Chain {
         }
         Self { power, subtree }
     }
+    /// The 100-leaf chain of the deep-tree tests: powers 1 to 5.
+    pub fn deep() -> Self {
+        Self::new((0..100).map(|k| 1.0 + ((k * 7) % 5) as f32).collect())
+    }
+
+    /// What the deep-tree tests record for leaf `k` of [`Chain::deep`]:
+    /// large for `k < 70` (skewed), a small tail whose total share (below
+    /// the default sigma) ends the learned cut at depth 70. Fresh half
+    /// splits reach a few levels deeper per refinement (16 take them
+    /// there), power splits all the way.
+    pub fn deep_target(k: u32) -> f32 {
+        if k < 70 {
+            1.0 + ((k * 3) % 7) as f32
+        } else {
+            0.05
+        }
+    }
+
     /// Number of leaves.
     pub fn n(&self) -> u32 {
         self.power.len() as u32
