@@ -574,8 +574,8 @@ proptest! {
 /// against the snapshot's pmf, and the two deepest leaves are drawn.
 #[test]
 fn a_deep_chain_is_sampled_in_distribution() {
-    let n = 100u32;
-    let chain = Chain::new((0..n).map(|k| 1.0 + ((k * 7) % 5) as f32).collect());
+    let chain = Chain::deep();
+    let n = chain.n();
     let scene = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
     for cut in [
         CutConfig::default(),
@@ -592,12 +592,7 @@ fn a_deep_chain_is_sampled_in_distribution() {
         let p = Vec3::new(0.5, 0.0, 0.0);
         for _ in 0..16 {
             for k in 0..n {
-                let t = if k < 70 {
-                    1.0 + ((k * 3) % 7) as f32
-                } else {
-                    0.05
-                };
-                glt.record_light_at(p, LightId::Emitter(k), t);
+                glt.record_light_at(p, LightId::Emitter(k), Chain::deep_target(k));
             }
             glt.refine();
         }
@@ -620,5 +615,87 @@ fn a_deep_chain_is_sampled_in_distribution() {
         let (z, _) = chi_square_z(&counts, &pmf).unwrap();
         assert!(z < common::Z_P_1E4, "z = {z}");
         assert!(counts[99] > 0 && counts[98] > 0);
+    }
+}
+
+/// A guiding field's snapshot chooses as the field's light vertex does
+/// (the field keeps its cuts in the same spatial tree as its quadtrees).
+#[test]
+fn a_fields_snapshot_chooses_as_the_field() {
+    use guiding::{FieldConfig, GuidingField};
+    let lights = mixed_scene(2000, 13);
+    let tree = LightTree::build(&lights, BuildHeuristic::default()).unwrap();
+    let scene = Aabb::new(Vec3::splat(-60.0), Vec3::splat(60.0));
+    let mut field = GuidingField::new(&tree, scene, FieldConfig::default()).unwrap();
+    let mut r = Rand::new(14);
+    for _ in 0..3 {
+        for _ in 0..20_000 {
+            let ctx = ShadingContext::on_surface(r.point(55.0), r.dir());
+            let Some(v) = field.vertex(&ctx) else {
+                continue;
+            };
+            let Some(s) = v.light.sample(&ctx, r.f()) else {
+                continue;
+            };
+            if let LightId::Emitter(e) = s.light {
+                let value = contribution(&lights[e as usize], ctx.position) / f64::from(s.pmf);
+                v.light.record_light(s.light, value as f32);
+            }
+        }
+        field.refine();
+    }
+    let snapshot = field.snapshot().unwrap();
+    let view = snapshot.view();
+    let (mut same, mut worst, queries) = (0usize, 0f64, 50_000);
+    for _ in 0..queries {
+        let ctx = ShadingContext::on_surface(r.point(58.0), r.dir());
+        let u = r.f();
+        let cpu = field.vertex(&ctx).and_then(|v| v.light.sample(&ctx, u));
+        let snap = view.sample(ctx.position, ctx.normal, u);
+        match (cpu, snap) {
+            (Some(c), Some(s)) if c.light == s.light => {
+                same += 1;
+                worst = worst.max(relative(s.pmf, f64::from(c.pmf)));
+            }
+            (None, None) => same += 1,
+            _ => {}
+        }
+    }
+    assert!(
+        same as f64 >= 0.9995 * queries as f64,
+        "{same} of {queries}"
+    );
+    assert!(worst <= 2e-6, "{worst}");
+}
+
+/// The snapshot's estimate of the direct light (contribution over pmf)
+/// is unbiased: its mean over 400,000 draws at each of four points is the
+/// exact sum over every light within four standard errors.
+#[test]
+fn the_snapshots_estimates_are_unbiased() {
+    let (lights, glt) = trained(500, CutConfig::default(), 17);
+    let snapshot = glt.snapshot().unwrap();
+    let view = snapshot.view();
+    let mut r = Rand::new(18);
+    for _ in 0..4 {
+        let ctx = ShadingContext::on_surface(r.point(50.0), r.dir());
+        let exact: f64 = lights.iter().map(|e| contribution(e, ctx.position)).sum();
+        let draws = 400_000;
+        let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+        for _ in 0..draws {
+            let s = view.sample(ctx.position, ctx.normal, r.f()).unwrap();
+            let LightId::Emitter(e) = s.light else {
+                panic!("no unbounded light")
+            };
+            let x = contribution(&lights[e as usize], ctx.position) / f64::from(s.pmf);
+            sum += x;
+            sum2 += x * x;
+        }
+        let mean = sum / draws as f64;
+        let se = ((sum2 / draws as f64 - mean * mean) / draws as f64).sqrt();
+        assert!(
+            (mean - exact).abs() <= 4.0 * se,
+            "mean {mean}, exact {exact}, se {se}"
+        );
     }
 }
