@@ -220,8 +220,8 @@ impl<H: LightHierarchy> GuidingField<H> {
 
     /// Every cell's learned light choice as plain-data arrays a GPU
     /// kernel samples ([`crate::snapshot`], as
-    /// [`Glt::snapshot`](crate::Glt::snapshot)); the directional half (the SD-trees) is not
-    /// in it.
+    /// [`Glt::snapshot`](crate::Glt::snapshot)); the directional half
+    /// (the SD-trees) is not in it.
     pub fn snapshot(&self) -> Result<Snapshot, SnapshotError> {
         Snapshot::new(&self.guide, &self.cells)
     }

@@ -9,7 +9,7 @@ use super::layout::{
     BELOW_IMPORTANCE, Cell, LEAF, MODULATED, NO_EMITTER, PRIOR, PRIOR_IMPORTANCE, TreeEntry,
 };
 use super::view::SnapshotView;
-use crate::cut::CutNode;
+use crate::cut::{CutNode, Slot};
 use crate::light_sampler::LightId;
 use crate::math::Side;
 use glam::Vec3;
@@ -189,8 +189,8 @@ impl<'v, 'a> Rule<'v, 'a> {
                     cut: Some(cut),
                     prior,
                     next: [Side::Left, Side::Right].map(|s| match node.slot(s) {
-                        crate::cut::Slot::Child(j) => Some(j),
-                        crate::cut::Slot::End(_) => None,
+                        Slot::Child(j) => Some(j),
+                        Slot::End(_) => None,
                     }),
                 }
             }
