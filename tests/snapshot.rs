@@ -699,3 +699,15 @@ fn the_snapshots_estimates_are_unbiased() {
         );
     }
 }
+
+/// `Debug` names the header and the arrays' lengths, not every entry.
+#[test]
+fn debug_prints_a_summary() {
+    let snapshot = small_snapshot();
+    let text = format!("{:?} {:?}", snapshot, snapshot.view());
+    assert!(
+        text.contains("magic") && text.contains("cut_nodes"),
+        "{text}"
+    );
+    assert!(text.len() < 2000, "{} bytes of Debug", text.len());
+}

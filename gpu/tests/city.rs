@@ -1,4 +1,4 @@
-//! The GPU kernel on a trained city (108,693 emissive triangles): a million
+//! The GPU kernel on a trained city (108,693 lights): a million
 //! queries sampled on whatever adapter `wgpu` finds (Mesa's lavapipe where
 //! there is no GPU) and compared with the snapshot's CPU sampler, and the
 //! snapshot's CPU sampler compared with the GLT it was taken from.

@@ -76,8 +76,9 @@ use alloc::vec::Vec;
 /// A trained guide's light choice as owned plain-data arrays (see the
 /// [module](self)). Built by [`Glt::snapshot`](crate::Glt::snapshot) and
 /// [`GuidingField::snapshot`](crate::GuidingField::snapshot); always
-/// valid, so [`Snapshot::view`] cannot fail.
-#[derive(Clone, Debug, PartialEq)]
+/// valid, so [`Snapshot::view`] cannot fail. `Debug` prints the header
+/// and the arrays' lengths.
+#[derive(Clone, PartialEq)]
 pub struct Snapshot {
     header: Header,
     spatial: Vec<u32>,
@@ -89,6 +90,12 @@ pub struct Snapshot {
     first_right: Vec<u32>,
     bounds: Vec<BoundsPair>,
     leaf_position: Vec<u32>,
+}
+
+impl core::fmt::Debug for Snapshot {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_tuple("Snapshot").field(&self.arrays()).finish()
+    }
 }
 
 impl Snapshot {

@@ -9,7 +9,9 @@ use crate::math::Side;
 /// A snapshot's arrays as slices: what to upload to a GPU, one buffer
 /// each, or what a reader that got them elsewhere (a file, a mapped
 /// buffer) hands to [`SnapshotView::new`]. `docs/format.md` describes each.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// `Debug` prints the header and each array's length, not the arrays (a
+/// city's are megabytes of text).
+#[derive(Clone, Copy, PartialEq)]
 pub struct SnapshotArrays<'a> {
     /// Counts and shared rules.
     pub header: &'a Header,
@@ -36,6 +38,23 @@ pub struct SnapshotArrays<'a> {
     /// Per emitter, its leaf's position in depth-first leaf order
     /// (`u32::MAX` for an emitter with no leaf).
     pub leaf_position: &'a [u32],
+}
+
+impl core::fmt::Debug for SnapshotArrays<'_> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("SnapshotArrays")
+            .field("header", self.header)
+            .field("spatial", &self.spatial.len())
+            .field("cells", &self.cells.len())
+            .field("cut_nodes", &self.cut_nodes.len())
+            .field("fractions", &self.fractions.len())
+            .field("visibility", &self.visibility.len())
+            .field("tree", &self.tree.len())
+            .field("first_right", &self.first_right.len())
+            .field("bounds", &self.bounds.len())
+            .field("leaf_position", &self.leaf_position.len())
+            .finish()
+    }
 }
 
 impl SnapshotArrays<'_> {

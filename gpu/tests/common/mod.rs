@@ -1,5 +1,5 @@
 //! The trained city both the GPU test and the throughput example use: the
-//! render example's `city` (108,693 emissive triangles), a GLT trained as
+//! render example's `city` (108,693 lights), a GLT trained as
 //! `pt-glt` trains it, and queries at the first non-specular vertices of
 //! camera paths with their numbers.
 #![allow(dead_code)]
