@@ -711,3 +711,49 @@ fn debug_prints_a_summary() {
     );
     assert!(text.len() < 2000, "{} bytes of Debug", text.len());
 }
+
+/// The number's edges, as every sampler's (`tests/edge_semantics.rs`):
+/// below 0 and NaN count as 0, 1 and above as the largest `f32` below 1;
+/// `u = 0` never takes a side of probability 0 (a dark light on the
+/// left), nor does the largest number (a dark light on the right).
+#[test]
+fn the_numbers_edges() {
+    let below_one = 1.0 - f32::EPSILON / 2.0;
+    let scene = Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0));
+    // Two leaves under the root, the dark one left, then right.
+    for dark in [0u32, 1] {
+        let tree = Chain::new(if dark == 0 {
+            vec![0.0, 1.0]
+        } else {
+            vec![1.0, 0.0]
+        });
+        for rules in [
+            CutConfig::default(),
+            CutConfig::default().with_paper_rules(),
+        ] {
+            let config = GltConfig {
+                cut: rules,
+                ..GltConfig::default()
+            };
+            let glt = Glt::new(&tree, scene, config).unwrap();
+            let snapshot = glt.snapshot().unwrap();
+            let view = snapshot.view();
+            let p = Vec3::new(0.0, 2.0, 0.0);
+            let at = |u: f32| view.sample(p, Some(Vec3::Y), u);
+            for u in [f32::NAN, -1.0, -0.0, f32::NEG_INFINITY] {
+                assert_eq!(at(u), at(0.0), "u = {u}");
+            }
+            for u in [1.0, 7.5, f32::INFINITY] {
+                assert_eq!(at(u), at(below_one), "u = {u}");
+            }
+            // The dark light is on the side the extreme number walks to.
+            let extreme = if dark == 0 { 0.0 } else { below_one };
+            let s = at(extreme).expect("the lit light");
+            assert_eq!(
+                (s.light, s.pmf),
+                (LightId::Emitter(1 - dark), 1.0),
+                "u = {extreme}"
+            );
+        }
+    }
+}

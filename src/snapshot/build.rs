@@ -179,3 +179,16 @@ fn bounds_pairs(tables: &TreeTables, pairs: usize) -> Vec<BoundsPair> {
 
 /// `CutNode` is the snapshot's cut-node record as it is.
 const _: () = assert!(core::mem::size_of::<CutNode>() == 12);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Counts and indices up to 2^31 - 1 fit; 2^31 (the leaf flag) is
+    /// refused, named.
+    #[test]
+    fn indices_stop_below_the_leaf_flag() {
+        assert_eq!(index((1 << 31) - 1, "x"), Ok((1 << 31) - 1));
+        assert_eq!(index(1 << 31, "x"), Err(SnapshotError::TooLarge("x")));
+    }
+}
