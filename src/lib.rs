@@ -124,6 +124,10 @@
 // (used by the tests and benchmarks through `inspect`) are unreachable; with
 // it every module is public, and the compiler checks what is truly unused.
 #![cfg_attr(not(feature = "inspect"), allow(dead_code, unused_imports))]
+// Every type in a public signature can be named from the front (the crate
+// root and its public modules), so a renderer can write down what a call
+// returns. Without `inspect` only the front is public, which this checks.
+#![cfg_attr(not(feature = "inspect"), deny(unnameable_types))]
 
 extern crate alloc;
 
@@ -187,9 +191,11 @@ macro_rules! inspect_tier {
     };
 }
 
-// A trained guide's light choice as plain-data arrays for GPU kernels,
-// and its sampling rule over them: always public (a renderer's GPU path
-// needs the layout).
+// Always public, each a small module of its own: the configuration's
+// knobs, what a guide learned (to read), and a trained guide's light choice
+// as plain-data arrays for GPU kernels with its sampling rule over them.
+pub mod config;
+pub mod learned;
 pub mod snapshot;
 
 inspect_tier! {
@@ -223,11 +229,15 @@ pub use glam;
 // The lights and the shading point.
 pub use emitter::{Emitter, Emitters};
 pub use light_tree::{
-    BuildError, BuildHeuristic, Instance, InstancedLightTree, LightHierarchy, LightTree,
+    BuildError, BuildHeuristic, EmitterPath, Instance, InstancedLightTree, LightHierarchy,
+    LightTree, NodeBounds,
 };
-pub use math::{Aabb, Accumulation, luminance};
+pub use math::{Aabb, Accumulation, LightCone, Side, luminance};
 // Choosing lights.
-pub use light_sampler::{LightId, LightSample, LightSampler, ShadingContext, UnboundedLights};
+pub use light_sampler::{
+    ImportanceTreeSampler, LightId, LightSample, LightSampler, PowerSampler, PowerTreeSampler,
+    ShadingContext, UnboundedLights, UniformSampler, WithUnbounded,
+};
 pub use strategy::Strategy;
 // The guides, their configurations and their vertices.
 pub use cut::{CutConfig, LightVertex};
@@ -239,12 +249,13 @@ pub use spatial::{RefineOutcome, SpatialFilter};
 // What a renderer records and computes with them.
 pub use dropped::DroppedRecords;
 pub use mis::{Convention, DirectEstimate, DirectLight};
-pub use path_recorder::PathRecorder;
+pub use path_recorder::{PathRecorder, PathSegment};
 pub use record::RecordOutcome;
 pub use resampling::{BsdfCandidate, Evaluated, Resampled, resample};
-pub use schedule::{InverseVarianceCombiner, Iterations};
+pub use schedule::{InverseVarianceCombiner, Iteration, Iterations, PassStats};
 #[cfg(feature = "std")]
-pub use shared_guide::SharedGuide;
+pub use shared_guide::{Refine, SharedGuide};
 // Errors.
 pub use error::{ConfigError, Error};
+pub use spatial::SpatialError;
 pub use persist::LoadError;

@@ -37,7 +37,7 @@ use glam::Vec3;
 /// which pdfs and throughput factor, and (after [`PathRecorder::finish`])
 /// the radiance that arrived back along it.
 #[derive(Clone, Copy, Debug)]
-pub struct Segment<'a> {
+pub struct PathSegment<'a> {
     /// The directional guiding of the vertex the path left from, which
     /// [`PathRecorder::finish`] records into; `None` for a vertex nothing
     /// learns at.
@@ -68,7 +68,7 @@ pub struct Segment<'a> {
 /// storage is kept). See the module docs.
 #[derive(Clone, Debug)]
 pub struct PathRecorder<'a> {
-    segments: Vec<Segment<'a>>,
+    segments: Vec<PathSegment<'a>>,
     throughput: Vec3,
     estimate: Vec3,
 }
@@ -132,7 +132,7 @@ impl<'a> PathRecorder<'a> {
         weight: Vec3,
     ) {
         self.throughput *= weight;
-        self.segments.push(Segment {
+        self.segments.push(PathSegment {
             vertex,
             direction,
             pdf,
@@ -165,7 +165,7 @@ impl<'a> PathRecorder<'a> {
 
     /// The recorded segments (their `incident` radiance is filled by
     /// [`PathRecorder::finish`]).
-    pub fn segments(&self) -> &[Segment<'a>] {
+    pub fn segments(&self) -> &[PathSegment<'a>] {
         &self.segments
     }
 
