@@ -257,5 +257,5 @@ pub use schedule::{InverseVarianceCombiner, Iteration, Iterations, PassStats};
 pub use shared_guide::{Refine, SharedGuide};
 // Errors.
 pub use error::{ConfigError, Error};
-pub use spatial::SpatialError;
 pub use persist::LoadError;
+pub use spatial::SpatialError;
