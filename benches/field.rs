@@ -13,6 +13,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
+use guiding::LightChoice;
 use guiding::RecordOutcome;
 use guiding::field::{FieldConfig, GuidingField};
 use guiding::glt::{Glt, GltConfig};
@@ -111,7 +112,7 @@ fn train<'a>(lights: &[Emitter], tree: &'a LightTree) -> Trained<'a> {
             let r = record(lights, &mut rng);
             let ctx = ShadingContext::at(r.p);
             let v = field.vertex(&ShadingContext::at(r.p)).unwrap();
-            if let Some(s) = v.light.sample(&ctx, r.u) {
+            if let Some(s) = v.light.sample(r.u) {
                 let LightId::Emitter(e) = s.light else {
                     continue;
                 };
@@ -175,7 +176,7 @@ fn bench_field(c: &mut Criterion) {
             let (ctx, u) = black_box(&queries[next()]);
             let v = field.vertex(ctx).unwrap();
             let d = v.direction.sample_direction([u[0], u[1]]);
-            (d, v.light.sample(ctx, u[2]))
+            (d, v.light.sample(u[2]))
         })
     });
     // The same with a separate SD-tree and GLT: two lookups.
@@ -193,7 +194,7 @@ fn bench_field(c: &mut Criterion) {
             let (ctx, u) = black_box(&queries[next()]);
             let v = field.vertex(ctx).unwrap();
             let (dir, pdf) = v.direction.sample_direction([u[0], u[1]]);
-            let outcome = match v.light.sample(ctx, u[2]) {
+            let outcome = match v.light.sample(u[2]) {
                 Some(s) => v.light.record_light(s.light, 0.5 / s.pmf),
                 None => RecordOutcome::Dropped,
             };

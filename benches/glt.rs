@@ -24,7 +24,9 @@ use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::PowerTreeSampler;
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Aabb;
-use guiding::{Emitter, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext};
+use guiding::{
+    Emitter, LightChoice, LightHierarchy, LightId, LightSampler, LightTree, ShadingContext,
+};
 use std::hint::black_box;
 
 #[path = "../tests/common/mod.rs"]
@@ -276,23 +278,23 @@ fn bench_sampling(c: &mut Criterion) {
                 b.iter(|| {
                     let i = next();
                     let ctx = ShadingContext::on_surface(points[i], Vec3::Y);
-                    let s = ByPosition(&glt)
-                        .sample(black_box(&ctx), black_box(u[i]))
-                        .unwrap();
-                    ByPosition(&glt).pmf(&ctx, s.light)
+                    let v = glt.vertex(black_box(&ctx)).unwrap();
+                    let s = v.sample(black_box(u[i])).unwrap();
+                    v.pmf(s.light)
                 })
             });
             // The same queries through the GPU snapshot's f32 sampler on
-            // the CPU (src/snapshot/): the cell lookup is in each call.
+            // the CPU (src/snapshot/): one cell lookup per query, as the
+            // GLT's vertex.
             let snapshot = glt.snapshot().unwrap();
             let view = snapshot.view();
             group.bench_function("snapshot/sample+pmf", |b| {
                 b.iter(|| {
                     let i = next();
-                    let s = view
-                        .sample(black_box(points[i]), Some(Vec3::Y), black_box(u[i]))
-                        .unwrap();
-                    view.pmf(points[i], Some(Vec3::Y), s.light)
+                    let ctx = ShadingContext::on_surface(points[i], Vec3::Y);
+                    let v = view.vertex(black_box(&ctx)).unwrap();
+                    let s = v.sample(black_box(u[i])).unwrap();
+                    v.pmf(s.light)
                 })
             });
             group.bench_function("glt/sample", |b| {
@@ -305,7 +307,9 @@ fn bench_sampling(c: &mut Criterion) {
             group.bench_function("snapshot/sample", |b| {
                 b.iter(|| {
                     let i = next();
-                    view.sample(black_box(points[i]), Some(Vec3::Y), black_box(u[i]))
+                    let ctx = ShadingContext::on_surface(points[i], Vec3::Y);
+                    view.vertex(black_box(&ctx))
+                        .and_then(|v| v.sample(black_box(u[i])))
                 })
             });
             group.bench_function("power/sample+pmf-moving", |b| {

@@ -17,6 +17,7 @@ use criterion::{
     BenchmarkGroup, BenchmarkId, Criterion, SamplingMode, criterion_group, criterion_main,
 };
 use glam::{Affine3A, Quat, Vec3};
+use guiding::LightChoice;
 use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::ImportanceTreeSampler;
 use guiding::light_tree::{BuildHeuristic, shape_fingerprint};
@@ -324,8 +325,7 @@ fn instanced_queries(c: &mut Criterion) {
             .iter()
             .map(|(ctx, u)| {
                 glt.vertex(ctx).map_or(0.0, |v| {
-                    v.sample(ctx, *u)
-                        .map_or(0.0, |x| x.pmf + v.pmf(ctx, x.light))
+                    v.sample(*u).map_or(0.0, |x| x.pmf + v.pmf(x.light))
                 })
             })
             .sum()

@@ -16,8 +16,8 @@
 
 use guiding::glam::Vec3;
 use guiding::{
-    Aabb, BuildHeuristic, Convention, Emitter, Glt, GltConfig, LightId, LightSampler, LightTree,
-    LightVertex, ShadingContext, Strategy, UnboundedLights,
+    Aabb, BuildHeuristic, Convention, Emitter, Glt, GltConfig, LightChoice, LightId, LightSampler,
+    LightTree, LightVertex, SamplerAt, ShadingContext, Strategy, UnboundedLights,
 };
 use rand_pcg::Pcg32;
 use rand_pcg::rand_core::{Rng, SeedableRng};
@@ -87,14 +87,14 @@ enum Nee<'a> {
 impl<'a> Nee<'a> {
     /// Runs `f` with the light choice at `ctx`: the GLT's vertex there
     /// (one lookup; also what to record into when learning) or the fixed
-    /// sampler.
+    /// sampler at the point.
     fn at<R>(
         self,
         ctx: &ShadingContext,
-        f: impl FnOnce(&dyn LightSampler, Option<&LightVertex<'a, &'a LightTree>>) -> R,
+        f: impl FnOnce(&dyn LightChoice, Option<&LightVertex<'a, &'a LightTree>>) -> R,
     ) -> R {
         match self {
-            Nee::Fixed(s) => f(s, None),
+            Nee::Fixed(s) => f(&SamplerAt::new(s, ctx), None),
             Nee::Guided { glt, learn } => {
                 let v = glt.vertex(ctx).expect("the floor's points are finite");
                 f(&v, learn.then_some(&v))
@@ -108,23 +108,24 @@ impl<'a> Nee<'a> {
 /// true, .. }`, both are recorded into the GLT.
 fn estimate(lights: &[Sphere], nee: Nee, p: Vec3, rng: &mut Pcg32) -> f32 {
     let ctx = ShadingContext::on_surface(p, Vec3::Y);
-    nee.at(&ctx, |sampler, record| {
-        estimate_with(lights, sampler, record, &ctx, rng)
+    nee.at(&ctx, |choice, record| {
+        estimate_with(lights, choice, record, p, rng)
     })
 }
 
-/// [`estimate`] with the light choice located.
+/// [`estimate`] with the light choice at `p` made.
 fn estimate_with(
     lights: &[Sphere],
-    sampler: &dyn LightSampler,
+    choice: &dyn LightChoice,
     record: Option<&LightVertex<&LightTree>>,
-    ctx: &ShadingContext,
+    p: Vec3,
     rng: &mut Pcg32,
 ) -> f32 {
-    let (p, n) = (ctx.position, Vec3::Y);
+    let n = Vec3::Y;
     let mut e = 0.0;
-    // NEE: choose a light, then a direction towards it.
-    if let Some(s) = sampler.sample(ctx, uniform(rng)) {
+    // NEE: choose a light (its number drawn from the renderer's own
+    // generator), then a direction towards it.
+    if let Some(s) = (&choice).sample_with(rng) {
         let LightId::Emitter(i) = s.light else {
             unreachable!("no unbounded lights here")
         };
@@ -153,7 +154,7 @@ fn estimate_with(
         if visible(p, light.center) {
             let (_, pdf_dir) = sample_sphere(light, p, [0.0, 0.0]);
             let id = LightId::Emitter(i as u32);
-            let d = Convention::PbrtV4.bsdf_sample(sampler.pmf(ctx, id), pdf_dir, pdf_bsdf);
+            let d = Convention::PbrtV4.bsdf_sample(choice.pmf(id), pdf_dir, pdf_bsdf);
             e += light.radiance * dir.y * d.factor;
             if let Some(v) = &record {
                 v.record_light(id, light.radiance * d.factor);
@@ -231,10 +232,7 @@ pub fn run() -> bool {
     let left = ShadingContext::on_surface(Vec3::new(-2.0, 0.0, 0.0), Vec3::Y);
     let hidden = |nee: Nee| -> f32 {
         nee.at(&left, |s, _| {
-            (1..32)
-                .step_by(2)
-                .map(|i| s.pmf(&left, LightId::Emitter(i)))
-                .sum()
+            (1..32).step_by(2).map(|i| s.pmf(LightId::Emitter(i))).sum()
         })
     };
     let uniform_sampler =

@@ -19,11 +19,12 @@
 //! noise of its own (only the training's).
 
 use glam::Vec3;
+use guiding::LightChoice;
 use guiding::cut::{BelowCut, CutConfig, SplitPrior};
 use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Aabb;
-use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
+use guiding::{Emitter, LightId, LightTree, ShadingContext};
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -99,7 +100,7 @@ fn main() {
                         let p = Vec3::new(rs.f() * 40.0 - 20.0, 0.0, rs.f() * 40.0 - 20.0);
                         let ctx = ShadingContext::on_surface(p, Vec3::Y);
                         let vertex = glt.vertex(&ctx).expect("a finite point");
-                        let Some(s) = vertex.sample(&ctx, rs.f()) else {
+                        let Some(s) = vertex.sample(rs.f()) else {
                             continue;
                         };
                         let LightId::Emitter(e) = s.light else {
@@ -121,7 +122,7 @@ fn main() {
                             continue;
                         }
                         total += fe;
-                        let pe = vertex.pmf_exact(&ctx, LightId::Emitter(e as u32));
+                        let pe = vertex.pmf_exact(LightId::Emitter(e as u32));
                         if pe > 0.0 {
                             m2 += fe * fe / pe;
                         } else {

@@ -22,8 +22,8 @@ use guiding::light_sampler::ImportanceTreeSampler;
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Aabb;
 use guiding::{
-    Emitter, Instance, InstancedLightTree, LightHierarchy, LightId, LightSampler, LightTree,
-    ShadingContext,
+    Emitter, Instance, InstancedLightTree, LightChoice, LightHierarchy, LightId, LightSampler,
+    LightTree, ShadingContext,
 };
 use rayon::prelude::*;
 
@@ -34,7 +34,7 @@ use common::{Rand, contribution, train_on_own_choices};
 const POINTS: usize = 200;
 
 /// The exact relative variance per sample of `s` at `ctx` over `lights`.
-fn variance(s: &dyn LightSampler, lights: &[Emitter], ctx: &ShadingContext) -> f64 {
+fn variance(s: &dyn LightChoice, lights: &[Emitter], ctx: &ShadingContext) -> f64 {
     let f: Vec<f64> = lights
         .iter()
         .map(|e| contribution(e, ctx.position))
@@ -47,7 +47,7 @@ fn variance(s: &dyn LightSampler, lights: &[Emitter], ctx: &ShadingContext) -> f
         .iter()
         .enumerate()
         .map(|(i, &f)| {
-            let pmf = s.pmf_exact(ctx, LightId::Emitter(i as u32));
+            let pmf = s.pmf_exact(LightId::Emitter(i as u32));
             let share = f / sum;
             match pmf > 0.0 {
                 true => share * share / pmf,
@@ -161,7 +161,12 @@ fn main() {
             .collect();
         let v: Vec<(f64, f64)> = points
             .par_iter()
-            .map(|ctx| (variance(&a, &flat, ctx), variance(&b, &flat, ctx)))
+            .map(|ctx| {
+                (
+                    variance(&a.at(ctx), &flat, ctx),
+                    variance(&b.at(ctx), &flat, ctx),
+                )
+            })
             .collect();
         let (glt_flat, glt_instanced) = (
             trained(&flat_tree, &flat, spread),

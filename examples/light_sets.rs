@@ -26,6 +26,7 @@
 //! ```
 
 use glam::Vec3;
+use guiding::LightChoice;
 use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::ImportanceTreeSampler;
 use guiding::light_tree::BuildHeuristic;
@@ -96,7 +97,7 @@ fn train(
         let s = set.unwrap_or_else(|| r.below(sets));
         let ctx = ShadingContext::at(p).lit_by(1 << s);
         let Some(v) = glt.vertex(&ctx) else { continue };
-        let Some(x) = v.sample(&ctx, r.f()) else {
+        let Some(x) = v.sample(r.f()) else {
             continue;
         };
         let LightId::Emitter(e) = x.light else {
@@ -110,7 +111,7 @@ fn train(
 
 /// The exact relative variance per sample of `sampler` at `ctx` over the
 /// lights it is lit by (0 where none contributes).
-fn variance(sampler: &dyn LightSampler, lights: &[Emitter], ctx: &ShadingContext) -> f64 {
+fn variance(sampler: &dyn LightChoice, lights: &[Emitter], ctx: &ShadingContext) -> f64 {
     let lit: Vec<(u32, f64)> = (0..lights.len() as u32)
         .filter(|&i| lights[i as usize].light_sets & ctx.receives != 0)
         .map(|i| (i, contribution(&lights[i as usize], ctx.position)))
@@ -123,7 +124,7 @@ fn variance(sampler: &dyn LightSampler, lights: &[Emitter], ctx: &ShadingContext
     let second: f64 = lit
         .iter()
         .map(|&(i, f)| {
-            let pmf = sampler.pmf_exact(ctx, LightId::Emitter(i));
+            let pmf = sampler.pmf_exact(LightId::Emitter(i));
             let s = f / sum;
             if pmf > 0.0 {
                 s * s / pmf
@@ -191,7 +192,7 @@ fn main() {
                         let m = masked.vertex(&ctx).unwrap();
                         let q = per_set[s as usize].vertex(&ctx).unwrap();
                         [
-                            variance(&bvh, &lights, &ctx),
+                            variance(&bvh.at(&ctx), &lights, &ctx),
                             variance(&m, &lights, &ctx),
                             variance(&q, &lights, &ctx),
                         ]

@@ -12,7 +12,7 @@ pub mod load {
     use guiding::glam::Vec3;
     use guiding::glt::Glt;
     use guiding::sd_tree::SdTree;
-    use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
+    use guiding::{Emitter, LightChoice, LightId, LightSampler, LightTree, ShadingContext};
 
     /// The light tree the learned structures are loaded against (a corpus
     /// built from it gets past the fingerprint check).
@@ -34,23 +34,22 @@ pub mod load {
     /// Where the loaded samplers are checked.
     const AT: Vec3 = Vec3::new(0.3, -0.2, 0.1);
 
-    fn check(s: &impl LightSampler, n: u32) {
-        let ctx = ShadingContext::at(AT);
+    fn check(s: &impl LightChoice, n: u32) {
         let total: f64 = (0..n)
-            .map(|e| s.pmf_exact(&ctx, LightId::Emitter(e)))
+            .map(|e| s.pmf_exact(LightId::Emitter(e)))
             .sum::<f64>()
             + (0..4)
-                .map(|i| s.pmf_exact(&ctx, LightId::Unbounded(i)))
+                .map(|i| s.pmf_exact(LightId::Unbounded(i)))
                 .sum::<f64>();
         assert_sums_to_one(s, total);
-        if let Some(x) = s.sample(&ctx, 0.37) {
-            assert_eq!(x.pmf, s.pmf(&ctx, x.light));
+        if let Some(x) = s.sample(0.37) {
+            assert_eq!(x.pmf, s.pmf(x.light));
         }
     }
 
     /// A sampler's pmfs sum to 1 at a finite point, or to exactly 0 when it
     /// can sample nothing (a loaded light tree whose powers are all 0).
-    fn assert_sums_to_one(s: &impl LightSampler, total: f64) {
+    fn assert_sums_to_one(s: &impl LightChoice, total: f64) {
         if s.is_empty() {
             assert_eq!(total, 0.0);
         } else {
@@ -155,10 +154,8 @@ pub mod load {
 
     fn load_checked(data: &[u8]) {
         if let Ok(t) = LightTree::from_bytes(data) {
-            check(
-                &guiding::light_sampler::ImportanceTreeSampler::new(&t),
-                t.nodes().len() as u32,
-            );
+            let sampler = guiding::ImportanceTreeSampler::new(&t);
+            check(&sampler.at(&ShadingContext::at(AT)), t.nodes().len() as u32);
         }
         if let Ok(g) = Glt::from_bytes(data, tree()) {
             check(&g.vertex(&ShadingContext::at(AT)).unwrap(), 8);
@@ -257,7 +254,7 @@ pub mod operations {
     use guiding::glam::Vec3;
     use guiding::glt::{Glt, GltConfig};
     use guiding::math::Aabb;
-    use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
+    use guiding::{Emitter, LightChoice, LightId, LightTree, ShadingContext};
 
     fn tree() -> &'static LightTree {
         static TREE: std::sync::OnceLock<LightTree> = std::sync::OnceLock::new();
@@ -278,17 +275,14 @@ pub mod operations {
         f32::from_le_bytes([b[0], b[1], b[2], b[3]])
     }
 
-    fn check(s: &impl LightSampler, p: Vec3, u: f32) {
-        let ctx = ShadingContext::at(p);
-        let total: f64 = (0..12)
-            .map(|e| s.pmf_exact(&ctx, LightId::Emitter(e)))
-            .sum();
+    fn check(s: &impl LightChoice, u: f32) {
+        let total: f64 = (0..12).map(|e| s.pmf_exact(LightId::Emitter(e))).sum();
         // Every light of the operations' tree has power: the pmf sums to 1
         // wherever the (finite, located) point is.
         assert!((total - 1.0).abs() < 1e-5, "{total}");
-        if let Some(x) = s.sample(&ctx, u) {
+        if let Some(x) = s.sample(u) {
             assert!(x.pmf > 0.0 && x.pmf.is_finite());
-            assert_eq!(x.pmf, s.pmf(&ctx, x.light));
+            assert_eq!(x.pmf, s.pmf(x.light));
         }
     }
 
@@ -331,8 +325,8 @@ pub mod operations {
                     let ctx = ShadingContext::at(p);
                     match (glt.vertex(&ctx), field.vertex(&ctx)) {
                         (Some(g), Some(f)) => {
-                            check(&g, p, u);
-                            check(&f.light, p, u);
+                            check(&g, u);
+                            check(&f.light, u);
                         }
                         // Only points that are not finite have no vertex.
                         (g, f) => assert!(g.is_none() && f.is_none() && !ctx.is_finite()),
@@ -341,7 +335,7 @@ pub mod operations {
             }
         }
         let origin = ShadingContext::at(Vec3::ZERO);
-        check(&glt.vertex(&origin).unwrap(), Vec3::ZERO, 0.5);
-        check(&field.vertex(&origin).unwrap().light, Vec3::ZERO, 0.5);
+        check(&glt.vertex(&origin).unwrap(), 0.5);
+        check(&field.vertex(&origin).unwrap().light, 0.5);
     }
 }

@@ -31,6 +31,6 @@ pub use crate::cut::{CutError, CutMemory, CutNode, CutRules, GuidingCut, Slot};
 pub use crate::field::{FieldCell, FieldMemory};
 pub use crate::glt::{GltCell, GltMemory};
 pub use crate::light_tree::LightNode;
-pub use crate::quadtree::{DirectionalTree, QuadLeaf};
+pub use crate::quadtree::{DirectionalTree, QuadLeaf, UNIFORM_PDF};
 pub use crate::sd_tree::{SdCell, SdTreeMemory};
 pub use crate::spatial::{BinaryTree, CellId, SpatialTree};

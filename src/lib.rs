@@ -226,6 +226,13 @@ inspect_tier! {
 /// so a renderer on another glam version names the crate's own.
 pub use glam;
 
+/// The random-generator traits (rand_core 0.10), re-exported so a renderer
+/// on another version names the crate's own: the `*_with` conveniences
+/// ([`LightChoice::sample_with`], [`LightSampler::sample_with`],
+/// [`DirectionVertex::sample_direction_with`]) draw their numbers from any
+/// [`rand_core::Rng`].
+pub use rand_core;
+
 // The lights and the shading point.
 pub use emitter::{Emitter, Emitters};
 pub use light_tree::{
@@ -235,8 +242,8 @@ pub use light_tree::{
 pub use math::{Aabb, Accumulation, LightCone, Side, luminance};
 // Choosing lights.
 pub use light_sampler::{
-    ImportanceTreeSampler, LightId, LightSample, LightSampler, PowerSampler, PowerTreeSampler,
-    ShadingContext, UnboundedLights, UniformSampler, WithUnbounded,
+    ImportanceTreeSampler, LightChoice, LightId, LightSample, LightSampler, PowerSampler,
+    PowerTreeSampler, SamplerAt, ShadingContext, UnboundedLights, UniformSampler, WithUnbounded,
 };
 pub use strategy::Strategy;
 // The guides, their configurations and their vertices.

@@ -112,7 +112,7 @@ impl DirectLight {
     ///
     /// ```
     /// use guiding::glam::Vec3;
-    /// use guiding::mis::Convention;
+    /// use guiding::Convention;
     /// // A light chosen with pmf 0.25, its point sampled with solid-angle
     /// // pdf 2, the BSDF sampling that direction with pdf 0.5.
     /// let d = Convention::PbrtV4.light_sample(0.25, 2.0, 0.5);

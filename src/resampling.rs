@@ -1,6 +1,7 @@
 //! Resampled light choice (resampled importance sampling, Talbot et al.
 //! 2005; the candidate-reservoir form of ReSTIR, Bitterli et al. 2020):
-//! draw `M` candidate lights from any [`LightSampler`], let the renderer
+//! draw `M` candidate lights from any [`LightChoice`] (a guide's vertex,
+//! or a sampler at the point), let the renderer
 //! evaluate each one's *unshadowed* contribution (it samples the point on
 //! the light itself, no shadow ray), and keep one in proportion to that
 //! contribution over its pmf. The kept light comes with a weight that takes
@@ -13,7 +14,7 @@
 //! and the renderer's unshadowed estimate `c_j = f cos Le / p_l` at `y_j`,
 //! the candidate weights are `w_j = c_j t_j / P(l_j)` (`t_j` the
 //! renderer's factor, if any, times the square root of what the sampler
-//! learned of the light's visibility, [`LightSampler::visibility`]), one
+//! learned of the light's visibility, [`LightChoice::visibility`]), one
 //! candidate `s` is kept with probability `w_s / sum w`, and
 //!
 //! ```text
@@ -79,8 +80,7 @@
 //! the BSDF sample, with the pmf of the light it hit, as without
 //! resampling.
 
-use crate::light_sampler::ShadingContext;
-use crate::light_sampler::{LightId, LightSampler};
+use crate::light_sampler::{LightChoice, LightId};
 use crate::math::scalar::sqrt64;
 use crate::math::{Descent, Side};
 
@@ -183,9 +183,11 @@ impl<T> Evaluated<T> {
 /// `pdf_bsdf` positive).
 pub type BsdfCandidate<T> = (LightId, Evaluated<T>);
 
-/// Chooses a light at `ctx` by resampling `candidates.len()` candidates of
-/// `sampler`, and the BSDF sample's light when it takes part: candidate
-/// `j` is drawn with `sampler.sample(ctx, candidates[j])`,
+/// Chooses a light at a shading point by resampling `candidates.len()`
+/// candidates of the point's light choice `lights` (a guide's vertex, or
+/// [`LightSampler::at`](crate::LightSampler::at) the point), and the BSDF
+/// sample's light when it takes part: candidate `j` is drawn with
+/// `lights.sample(candidates[j])`,
 /// `evaluate(light, j)` says what it contributes without visibility (the
 /// renderer samples a point on the light; `None` counts as no
 /// contribution), and `u` keeps one in proportion to its weight (see the
@@ -198,21 +200,20 @@ pub type BsdfCandidate<T> = (LightId, Evaluated<T>);
 ///
 /// Deterministic: the same numbers and evaluations give the same choice.
 /// `evaluate` is called once per candidate the sampler draws, in order.
-pub fn resample<S, T>(
-    sampler: &S,
-    ctx: &ShadingContext,
+pub fn resample<L, T>(
+    lights: &L,
     candidates: &[f32],
     u: f32,
     bsdf: Option<BsdfCandidate<T>>,
     mut evaluate: impl FnMut(LightId, usize) -> Option<Evaluated<T>>,
 ) -> Option<Resampled<T>>
 where
-    S: LightSampler + ?Sized,
+    L: LightChoice + ?Sized,
 {
     let m = candidates.len() as f64;
     let mut reservoir = Reservoir::new(u);
     for (j, &uj) in candidates.iter().enumerate() {
-        let Some((x, learned)) = sampler.sample_with_visibility(ctx, uj) else {
+        let Some((x, learned)) = lights.sample_with_visibility(uj) else {
             continue;
         };
         let Some(e) = evaluate(x.light, j) else {
@@ -221,7 +222,7 @@ where
         reservoir.offer(x.light, x.pmf, m, learned, e, false);
     }
     if let Some((light, e)) = bsdf.filter(|(_, e)| e.pdf_bsdf > 0.0) {
-        reservoir.offer(light, sampler.pmf(ctx, light), m, 1.0, e, true);
+        reservoir.offer(light, lights.pmf(light), m, 1.0, e, true);
     }
     let (light, pmf, target, payload, from_bsdf) = reservoir.kept?;
     let weight = (reservoir.total / target) as f32;

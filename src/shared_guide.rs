@@ -55,9 +55,8 @@ impl<H: LightHierarchy> Refine for GuidingField<H> {
 /// (it would wait for itself); `try_refine` returns `None` then.
 ///
 /// ```
-/// use guiding::shared_guide::SharedGuide;
-/// use guiding::{glam::Vec3, glt::{Glt, GltConfig}, math::Aabb, Emitter, LightTree};
-/// use guiding::{LightSampler, ShadingContext};
+/// use guiding::{glam::Vec3, Aabb, Emitter, Glt, GltConfig, LightTree};
+/// use guiding::{LightChoice, ShadingContext, SharedGuide};
 /// let lights = [Emitter::point(Vec3::Y, 1.0), Emitter::point(Vec3::X, 3.0)];
 /// let tree = LightTree::build(&lights[..], Default::default())?;
 /// let scene = Aabb::new(Vec3::splat(-2.0), Vec3::splat(2.0));
@@ -70,7 +69,7 @@ impl<H: LightHierarchy> Refine for GuidingField<H> {
 ///                 let glt = guide.read(); // one tile
 ///                 let ctx = ShadingContext::at(Vec3::new(0.1 * t as f32, 0.0, 0.1));
 ///                 let v = glt.vertex(&ctx).unwrap();
-///                 let x = v.sample(&ctx, 0.5).unwrap();
+///                 let x = v.sample(0.5).unwrap();
 ///                 v.record_light(x.light, 1.0 / x.pmf);
 ///                 drop(glt);
 ///                 if tile == 3 && t == 0 {

@@ -6,8 +6,8 @@ use crate::error::Error;
 use crate::glt::{Glt, GltConfig};
 use crate::light_sampler::ShadingContext;
 use crate::light_sampler::{
-    ImportanceTreeSampler, LightId, LightSample, LightSampler, PowerSampler, UnboundedLights,
-    UniformSampler, WithUnbounded,
+    ImportanceTreeSampler, LightChoice, LightId, LightSample, LightSampler, PowerSampler,
+    UnboundedLights, UniformSampler, WithUnbounded,
 };
 use crate::light_tree::{BuildHeuristic, LightTree};
 use crate::math::Aabb;
@@ -20,7 +20,7 @@ use crate::math::Aabb;
 /// (distant, infinite) beside the emitters.
 ///
 /// ```
-/// use guiding::{glam::Vec3, math::Aabb, Emitter, LightId, LightSampler};
+/// use guiding::{glam::Vec3, Aabb, Emitter, LightId, LightSampler};
 /// use guiding::{ShadingContext, Strategy, UnboundedLights};
 /// let lights = [Emitter::point(Vec3::Y, 1.0), Emitter::point(Vec3::X, 3.0)];
 /// let scene = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
@@ -108,18 +108,27 @@ impl Strategy {
     }
 }
 
-/// Calls `$call` on the sampler inside (a `match`, not a virtual call: this
-/// runs per sample).
+/// Calls `$call` on the chosen sampler at the point, as a
+/// [`LightChoice`] (a `match`, not a virtual call: this runs per sample).
 macro_rules! inner {
-    ($self:ident, $ctx:expr, $s:ident => $call:expr, $none:expr) => {
+    ($self:ident, $ctx:expr, $c:ident => $call:expr, $none:expr) => {
         match $self {
-            Strategy::Uniform($s) => $call,
-            Strategy::Power($s) => $call,
-            Strategy::Importance($s) => $call,
+            Strategy::Uniform(s) => {
+                let $c = s.at($ctx);
+                $call
+            }
+            Strategy::Power(s) => {
+                let $c = s.at($ctx);
+                $call
+            }
+            Strategy::Importance(s) => {
+                let $c = s.at($ctx);
+                $call
+            }
             // By position: one lookup per call (a renderer that also
             // records locates the vertex once, through `Strategy::glt`).
-            Strategy::Glt(g) => match g.vertex_uncounted($ctx.position) {
-                Some($s) => $call,
+            Strategy::Glt(g) => match g.vertex_uncounted($ctx) {
+                Some($c) => $call,
                 None => $none,
             },
         }
@@ -129,12 +138,12 @@ macro_rules! inner {
 impl LightSampler for Strategy {
     #[inline]
     fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
-        inner!(self, ctx, s => s.sample(ctx, u), None)
+        inner!(self, ctx, c => c.sample(u), None)
     }
 
     #[inline]
     fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        inner!(self, ctx, s => s.pmf(ctx, light), 0.0)
+        inner!(self, ctx, c => c.pmf(light), 0.0)
     }
 
     fn is_empty(&self) -> bool {
@@ -147,24 +156,24 @@ impl LightSampler for Strategy {
     }
 
     fn is_empty_at(&self, ctx: &ShadingContext) -> bool {
-        inner!(self, ctx, s => s.is_empty_at(ctx), true)
+        inner!(self, ctx, c => c.is_empty(), true)
     }
 
     #[inline]
     fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
-        inner!(self, ctx, s => s.sample_exact(ctx, u), None)
+        inner!(self, ctx, c => c.sample_exact(u), None)
     }
 
     #[inline]
     fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
-        inner!(self, ctx, s => s.pmf_exact(ctx, light), 0.0)
+        inner!(self, ctx, c => c.pmf_exact(light), 0.0)
     }
 
     fn visibility(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        inner!(self, ctx, s => s.visibility(ctx, light), 1.0)
+        inner!(self, ctx, c => c.visibility(light), 1.0)
     }
 
     fn sample_with_visibility(&self, ctx: &ShadingContext, u: f32) -> Option<(LightSample, f32)> {
-        inner!(self, ctx, s => s.sample_with_visibility(ctx, u), None)
+        inner!(self, ctx, c => c.sample_with_visibility(u), None)
     }
 }

@@ -4,6 +4,7 @@
 //! input counted, threads equal a serial run, and the memory report.
 
 use glam::Vec3;
+use guiding::LightChoice;
 use guiding::RecordOutcome;
 use guiding::cut::{BelowCut, CutConfig, CutRules, GuidingCut};
 use guiding::field::{FieldConfig, GuidingField};
@@ -128,11 +129,11 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
                 p => p,
             };
             let ctx = ShadingContext::at(p);
-            let v = field.vertex(&ShadingContext::at(p)).unwrap();
+            let v = field.vertex(&ctx).unwrap();
             let cut = &cuts[sd.spatial().locate(p).unwrap().index()];
             // NEE: the vertex's cut and the reference cut agree.
             let u = rng.f();
-            let s = v.light.sample(&ctx, u).unwrap();
+            let s = v.light.sample(u).unwrap();
             assert_eq!(Some(s), guide.sample(cut, &ctx, u));
             assert_eq!(s.pmf.to_bits(), guide.pmf(cut, &ctx, s.light).to_bits());
             let val = value(&lights, emitter(s.light), p) / s.pmf;
@@ -214,17 +215,14 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
         let p = rng.point(11.0);
         let ctx = ShadingContext::at(p);
         let cut = &cuts[sd.spatial().locate(p).unwrap().index()];
-        let v = field.vertex(&ShadingContext::at(p)).unwrap();
+        let v = field.vertex(&ctx).unwrap();
         for e in [0, 17, 39, 40, 79] {
             let l = LightId::Emitter(e);
             let x = guide.pmf_exact(cut, &ctx, l).to_bits();
-            assert_eq!(v.light.pmf_exact(&ctx, l).to_bits(), x);
+            assert_eq!(v.light.pmf_exact(l).to_bits(), x);
         }
         let u = rng.f64();
-        assert_eq!(
-            v.light.sample_exact(&ctx, u),
-            guide.sample_exact(cut, &ctx, u)
-        );
+        assert_eq!(v.light.sample_exact(u), guide.sample_exact(cut, &ctx, u));
     }
 }
 
@@ -282,8 +280,8 @@ fn equals_a_glt_fed_the_same_light_splats() {
                 ByPosition(field).sample(&ctx, u),
                 ByPosition(glt).sample(&ctx, u)
             );
-            let v = field.vertex(&ShadingContext::at(ctx.position)).unwrap();
-            assert_eq!(v.light.sample(&ctx, u), ByPosition(glt).sample(&ctx, u));
+            let v = field.vertex(&ctx).unwrap();
+            assert_eq!(v.light.sample(u), ByPosition(glt).sample(&ctx, u));
             for e in [3, 44, 71] {
                 let l = LightId::Emitter(e);
                 assert_eq!(
@@ -291,7 +289,7 @@ fn equals_a_glt_fed_the_same_light_splats() {
                     ByPosition(glt).pmf(&ctx, l).to_bits()
                 );
                 assert_eq!(
-                    v.light.pmf_exact(&ctx, l).to_bits(),
+                    v.light.pmf_exact(l).to_bits(),
                     ByPosition(glt).pmf_exact(&ctx, l).to_bits()
                 );
             }
@@ -385,9 +383,8 @@ proptest! {
         for _ in 0..iterations {
             for _ in 0..(200 + (rng.f() * 600.0) as usize) {
                 let p = rng.point(10.5);
-                let ctx = ShadingContext::at(p);
                 let v = field.vertex(&ShadingContext::at(p)).unwrap();
-                if let Some(s) = v.light.sample(&ctx, rng.f()) {
+                if let Some(s) = v.light.sample(rng.f()) {
                     let val = if rng.f() < 0.3 { 0.0 } else { rng.range(0.0, 3.0) / s.pmf };
                     prop_assert_ne!(v.light.record_light(s.light, val), RecordOutcome::Dropped);
                 }
@@ -402,19 +399,19 @@ proptest! {
         for _ in 0..25 {
             let p = rng.point(11.0);
             let ctx = ShadingContext::on_surface(p, rng.point(1.0).normalize_or(Vec3::Z));
-            let v = field.vertex(&ShadingContext::at(p)).unwrap();
+            let v = field.vertex(&ctx).unwrap();
             let mut total: f64 = (0..n as u32)
-                .map(|e| v.light.pmf_exact(&ctx, LightId::Emitter(e)))
+                .map(|e| v.light.pmf_exact(LightId::Emitter(e)))
                 .sum();
-            total += (0..unbounded).map(|i| v.light.pmf_exact(&ctx, LightId::Unbounded(i))).sum::<f64>();
+            total += (0..unbounded).map(|i| v.light.pmf_exact(LightId::Unbounded(i))).sum::<f64>();
             prop_assert!((total - 1.0).abs() < 1e-5, "pmf sums to {}", total);
             for _ in 0..20 {
                 let u = rng.f();
-                let s = v.light.sample(&ctx, u).unwrap();
-                prop_assert_eq!(s.pmf.to_bits(), v.light.pmf(&ctx, s.light).to_bits());
+                let s = v.light.sample(u).unwrap();
+                prop_assert_eq!(s.pmf.to_bits(), v.light.pmf(s.light).to_bits());
                 prop_assert_eq!(s.pmf.to_bits(), ByPosition(&field).pmf(&ctx, s.light).to_bits());
-                let (l, q) = v.light.sample_exact(&ctx, rng.f64()).unwrap();
-                prop_assert_eq!(q.to_bits(), v.light.pmf_exact(&ctx, l).to_bits());
+                let (l, q) = v.light.sample_exact(rng.f64()).unwrap();
+                prop_assert_eq!(q.to_bits(), v.light.pmf_exact(l).to_bits());
                 let (d, pdf) = v.direction.sample_direction([rng.f(), rng.f()]);
                 prop_assert!(pdf > 0.0);
                 prop_assert_eq!(pdf.to_bits(), v.direction.direction_pdf(d).to_bits());
@@ -444,7 +441,7 @@ fn trained_field<'a>(
                 p => p,
             };
             let v = field.vertex(&ShadingContext::at(p)).unwrap();
-            let s = v.light.sample(&ShadingContext::at(p), rng.f()).unwrap();
+            let s = v.light.sample(rng.f()).unwrap();
             let val = value(lights, emitter(s.light), p) / s.pmf;
             assert_ne!(v.light.record_light(s.light, val), RecordOutcome::Dropped);
             let d = light_dir(lights, p, &mut rng);
@@ -541,7 +538,6 @@ fn spatial_split_copies_both_payloads() {
         assert_eq!(cell.cut().accumulated(), (0.0, 0.0));
     }
     let far = Vec3::new(9.0, 9.0, 9.0);
-    let near_ctx = ShadingContext::at(p);
     let (vn, vf) = (
         field.vertex(&ShadingContext::at(p)).unwrap(),
         field.vertex(&ShadingContext::at(far)).unwrap(),
@@ -559,17 +555,21 @@ fn spatial_split_copies_both_payloads() {
     assert_eq!(vn.light.cut().confidence(), 1.0);
     assert_eq!(vf.light.cut().confidence(), 0.0);
     let l3 = LightId::Emitter(3);
+    // The far cell's cut asked at p (its vertex answers at its own point).
+    let near_ctx = ShadingContext::at(p);
+    let far_at_p = |vf: &guiding::FieldVertex<&LightTree>| {
+        CutRules::new(&tree, config.cut)
+            .unwrap()
+            .pmf_exact(vf.light.cut(), &near_ctx, l3)
+    };
     let prior = GuidingField::new(&tree, scene(), config).unwrap();
     let untrained = prior
         .vertex(&ShadingContext::at(p))
         .unwrap()
         .light
-        .pmf_exact(&near_ctx, l3);
-    assert_eq!(
-        vf.light.pmf_exact(&near_ctx, l3).to_bits(),
-        untrained.to_bits()
-    );
-    let learned = vn.light.pmf_exact(&near_ctx, l3);
+        .pmf_exact(l3);
+    assert_eq!(far_at_p(&vf).to_bits(), untrained.to_bits());
+    let learned = vn.light.pmf_exact(l3);
     assert!(learned > 1.2 * untrained, "{learned} against {untrained}");
     // A second round near p, another direction and light: only that cell
     // learns it; the far one keeps its copies.
@@ -597,11 +597,8 @@ fn spatial_split_copies_both_payloads() {
         vf.direction.direction_pdf(dir2).to_bits(),
         far_pdf.to_bits()
     );
-    assert_eq!(
-        vf.light.pmf_exact(&near_ctx, l3).to_bits(),
-        untrained.to_bits()
-    );
-    assert!(vn.light.pmf_exact(&near_ctx, LightId::Emitter(30)) > 0.5);
+    assert_eq!(far_at_p(&vf).to_bits(), untrained.to_bits());
+    assert!(vn.light.pmf_exact(LightId::Emitter(30)) > 0.5);
 }
 
 /// Bad input is dropped, counted per kind and never stored, through the
@@ -680,7 +677,7 @@ fn clearing_records_keeps_what_was_learned() {
         .vertex(&ShadingContext::at(p))
         .unwrap()
         .light
-        .pmf(&ShadingContext::at(p), LightId::Emitter(3));
+        .pmf(LightId::Emitter(3));
     assert!(field.dropped_records().total() > 0);
     field.clear_records();
     assert_eq!(field.dropped_records().total(), 0);
@@ -693,7 +690,7 @@ fn clearing_records_keeps_what_was_learned() {
         .vertex(&ShadingContext::at(p))
         .unwrap()
         .light
-        .pmf(&ShadingContext::at(p), LightId::Emitter(3));
+        .pmf(LightId::Emitter(3));
     assert_eq!(before.to_bits(), after.to_bits());
 }
 

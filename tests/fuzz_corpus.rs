@@ -53,8 +53,8 @@ fn load_seeds_and_corpus() {
         let seen = guiding::glt::Glt::from_bytes(&bytes[4], tree).unwrap();
         let ctx = guiding::ShadingContext::at(glam::Vec3::ZERO);
         let there = seen.vertex(&ctx).unwrap();
-        let learned = (0..8)
-            .map(|e| guiding::LightSampler::visibility(&there, &ctx, guiding::LightId::Emitter(e)));
+        let learned =
+            (0..8).map(|e| guiding::LightChoice::visibility(&there, guiding::LightId::Emitter(e)));
         assert!(learned.fold(1.0f32, f32::min) < 0.9);
     }
     for input in inputs("load") {

@@ -5,6 +5,7 @@
 //! across 60 decades and at 1M lights, concurrency and memory.
 
 use glam::Vec3;
+use guiding::LightChoice;
 use guiding::cut::{
     BelowCut, CutConfig, CutNode, CutRules, GuidingCut, Modulation, Prior, Slot, SplitPrior,
 };
@@ -117,8 +118,8 @@ fn assert_sample_matches_pmf<H: LightHierarchy + ?Sized>(
             assert_eq!(expected_total(guide), 0.0, "no sample at u={u}");
         }
         let u = rng.f();
-        if let Some(s) = sampler.sample(ctx, u) {
-            let q = sampler.pmf(ctx, s.light);
+        if let Some(s) = sampler.sample(u) {
+            let q = sampler.pmf(s.light);
             assert_eq!(s.pmf.to_bits(), q.to_bits(), "{:?} u={u}", s.light);
             assert!(s.pmf > 0.0);
         }
@@ -1326,8 +1327,9 @@ fn below_cut_importance_is_the_importance_walk() {
     }
 }
 
-/// `CutRules::sampler` is the cut as a `LightSampler`: the same draws,
-/// pmfs and visibility as the rules' own calls, and not empty.
+/// `CutRules::vertex` is the cut as a `LightChoice` at a point: the same
+/// draws, pmfs and visibility as the rules' own calls at that point, and
+/// not empty.
 #[test]
 fn a_cut_as_a_light_sampler_answers_as_its_rules() {
     let mut rng = Rand::new(51);
@@ -1345,23 +1347,25 @@ fn a_cut_as_a_light_sampler_answers_as_its_rules() {
         guide.splat_visibility(&cut, LightId::Emitter(e), 0.25, 1.0);
     }
     guide.refine(&mut cut);
-    let s = guide.vertex(&cut, &ShadingContext::at(Vec3::ZERO));
-    assert!(!s.is_empty());
+    assert!(
+        !guide
+            .vertex(&cut, &ShadingContext::at(Vec3::ZERO))
+            .is_empty()
+    );
     for _ in 0..500 {
         let ctx = ShadingContext::on_surface(rng.point(8.0), rng.dir());
+        let s = guide.vertex(&cut, &ctx);
+        assert_eq!(s.context(), &ctx);
         let (u, u64) = (rng.f(), rng.f64());
-        assert_eq!(s.sample(&ctx, u), guide.sample(&cut, &ctx, u));
-        assert_eq!(
-            s.sample_exact(&ctx, u64),
-            guide.sample_exact(&cut, &ctx, u64)
-        );
+        assert_eq!(s.sample(u), guide.sample(&cut, &ctx, u));
+        assert_eq!(s.sample_exact(u64), guide.sample_exact(&cut, &ctx, u64));
         let l = LightId::Emitter(rng.below(200));
-        assert_eq!(s.pmf(&ctx, l), guide.pmf(&cut, &ctx, l));
-        assert_eq!(s.pmf_exact(&ctx, l), guide.pmf_exact(&cut, &ctx, l));
-        assert_eq!(s.visibility(&ctx, l), guide.visibility(&cut, l));
-        assert!(s.visibility(&ctx, l) < 0.5, "learned from 1/4 records");
+        assert_eq!(s.pmf(l), guide.pmf(&cut, &ctx, l));
+        assert_eq!(s.pmf_exact(l), guide.pmf_exact(&cut, &ctx, l));
+        assert_eq!(s.visibility(l), guide.visibility(&cut, l));
+        assert!(s.visibility(l) < 0.5, "learned from 1/4 records");
         let with = guide.sample_with_visibility(&cut, &ctx, u);
-        assert_eq!(s.sample_with_visibility(&ctx, u), with);
+        assert_eq!(s.sample_with_visibility(u), with);
         assert_eq!(
             with,
             guide
@@ -1383,11 +1387,10 @@ fn a_cut_as_a_light_sampler_answers_as_its_rules() {
                 .vertex(&dark_cut, &ShadingContext::at(Vec3::ZERO))
                 .is_empty()
     );
-    let ctx = ShadingContext::at(Vec3::ZERO);
     assert_eq!(
         dark_rules
             .vertex(&dark_cut, &ShadingContext::at(Vec3::ZERO))
-            .sample(&ctx, 0.5),
+            .sample(0.5),
         None
     );
 }

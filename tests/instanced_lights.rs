@@ -7,6 +7,7 @@
 //! a positive pmf, so the estimate's expectation is the flat sum).
 
 use glam::{Affine3A, Quat, Vec3};
+use guiding::LightChoice;
 use guiding::cut::CutConfig;
 use guiding::field::{FieldConfig, GuidingField};
 use guiding::glt::{Glt, GltConfig};
@@ -169,12 +170,12 @@ fn it_names_every_emitter_once_and_bounds_what_is_below() {
 /// The contract of `s` at `ctx` over the flat lights: pmf sums to 1,
 /// draws report their pmf bit for bit, and no light that contributes has
 /// pmf 0 (so the estimate is unbiased: its expectation is the flat sum).
-fn check(name: &str, s: &dyn LightSampler, flat: &[Emitter], ctx: &ShadingContext, r: &mut Rand) {
+fn check(name: &str, s: &dyn LightChoice, flat: &[Emitter], ctx: &ShadingContext, r: &mut Rand) {
     let mut total = 0.0;
     let mut expectation = 0.0;
     let mut sum = 0.0;
     for (i, e) in flat.iter().enumerate() {
-        let pmf = s.pmf_exact(ctx, LightId::Emitter(i as u32));
+        let pmf = s.pmf_exact(LightId::Emitter(i as u32));
         let f = contribution(e, ctx.position);
         assert!(
             f == 0.0 || pmf > 0.0,
@@ -189,8 +190,8 @@ fn check(name: &str, s: &dyn LightSampler, flat: &[Emitter], ctx: &ShadingContex
     assert!((total - 1.0).abs() < 1e-6, "{name}: total {total}");
     assert!((expectation - sum).abs() <= 1e-9 * sum, "{name}");
     for _ in 0..40 {
-        let x = s.sample(ctx, r.f()).unwrap();
-        assert_eq!(x.pmf.to_bits(), s.pmf(ctx, x.light).to_bits(), "{name}");
+        let x = s.sample(r.f()).unwrap();
+        assert_eq!(x.pmf.to_bits(), s.pmf(x.light).to_bits(), "{name}");
     }
 }
 
@@ -206,8 +207,8 @@ fn every_tree_sampler_samples_it_exactly() {
             ShadingContext::at(p),
             ShadingContext::on_surface(p, r.dir()),
         ] {
-            check("importance", &importance, &flat, &ctx, &mut r);
-            check("power", &power, &flat, &ctx, &mut r);
+            check("importance", &importance.at(&ctx), &flat, &ctx, &mut r);
+            check("power", &power.at(&ctx), &flat, &ctx, &mut r);
         }
     }
     // The power tree's pmf is each light's share of the power, as flat.
@@ -228,7 +229,7 @@ fn draws_follow_the_pmf() {
     let Scene { tree, flat } = scene();
     let s = ImportanceTreeSampler::new(&tree);
     let ctx = ShadingContext::on_surface(Vec3::new(3.0, 1.0, -2.0), Vec3::Y);
-    let (_, z) = emitter_draws(&s, &ctx, flat.len(), 200_000, &mut Rand::new(73));
+    let (_, z) = emitter_draws(&s.at(&ctx), flat.len(), 200_000, &mut Rand::new(73));
     assert!(z < 4.0, "chi-square z {z}");
 }
 
@@ -278,9 +279,15 @@ fn the_glt_learns_inside_instances() {
         );
         for _ in 0..20 {
             let p = r.point(50.0);
-            let v = glt.light_at(p);
-            check("glt", &v, &flat, &ShadingContext::at(p), &mut r);
+            check(
+                "glt",
+                &glt.light_at(p),
+                &flat,
+                &ShadingContext::at(p),
+                &mut r,
+            );
             let on_surface = ShadingContext::on_surface(p, r.dir());
+            let v = glt.vertex(&on_surface).unwrap();
             check("glt", &v, &flat, &on_surface, &mut r);
         }
     }
@@ -356,7 +363,7 @@ fn per_mesh_tables_choose_as_world_tables_do() {
                 let tv: f64 = (0..flat.len() as u32)
                     .map(|e| {
                         let l = LightId::Emitter(e);
-                        (a.pmf_exact(&ctx, l) - b.pmf_exact(&ctx, l)).abs()
+                        (a.pmf_exact(l) - b.pmf_exact(l)).abs()
                     })
                     .sum::<f64>()
                     / 2.0;
@@ -410,10 +417,7 @@ fn a_glt_over_instances_saves_and_binds_by_its_parts() {
         let (a, b) = (glt.vertex(&ctx).unwrap(), back.vertex(&ctx).unwrap());
         for e in 0..flat.len() as u32 {
             let l = LightId::Emitter(e);
-            assert_eq!(
-                a.pmf_exact(&ctx, l).to_bits(),
-                b.pmf_exact(&ctx, l).to_bits()
-            );
+            assert_eq!(a.pmf_exact(l).to_bits(), b.pmf_exact(l).to_bits());
         }
     }
     // Moved as a whole: the same shape, other bounds.

@@ -5,6 +5,7 @@
 //! reports; a point that receives every set sees what it saw without sets.
 
 use glam::Vec3;
+use guiding::LightChoice;
 use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::{ImportanceTreeSampler, PowerTreeSampler};
 use guiding::light_tree::BuildHeuristic;
@@ -56,12 +57,12 @@ fn trained_glt<'a>(tree: &'a LightTree, lights: &[Emitter]) -> Glt<&'a LightTree
 /// The contract at `ctx` for `s` over `lights`: normalised over the lights
 /// the point receives (or nothing at all when it receives none), nothing
 /// else ever chosen, samples report their pmf exactly.
-fn check(name: &str, s: &dyn LightSampler, lights: &[Emitter], ctx: &ShadingContext, r: &mut Rand) {
+fn check(name: &str, s: &dyn LightChoice, lights: &[Emitter], ctx: &ShadingContext, r: &mut Rand) {
     let receives = |e: &Emitter| e.light_sets & ctx.receives != 0 && e.power > 0.0;
     let any = lights.iter().any(receives);
     let mut total = 0.0;
     for (i, e) in lights.iter().enumerate() {
-        let p = s.pmf_exact(ctx, LightId::Emitter(i as u32));
+        let p = s.pmf_exact(LightId::Emitter(i as u32));
         if !receives(e) {
             assert_eq!(
                 p, 0.0,
@@ -75,16 +76,16 @@ fn check(name: &str, s: &dyn LightSampler, lights: &[Emitter], ctx: &ShadingCont
         assert!((total - 1.0).abs() < 1e-6, "{name}: total {total}");
     } else {
         assert_eq!(total, 0.0, "{name}");
-        assert!(s.sample(ctx, 0.5).is_none(), "{name}");
+        assert!(s.sample(0.5).is_none(), "{name}");
         return;
     }
     for _ in 0..50 {
-        let x = s.sample(ctx, r.f()).unwrap();
+        let x = s.sample(r.f()).unwrap();
         let LightId::Emitter(e) = x.light else {
             panic!()
         };
         assert!(receives(&lights[e as usize]), "{name}: sampled light {e}");
-        assert_eq!(x.pmf.to_bits(), s.pmf(ctx, x.light).to_bits(), "{name}");
+        assert_eq!(x.pmf.to_bits(), s.pmf(x.light).to_bits(), "{name}");
     }
 }
 
@@ -105,11 +106,11 @@ fn every_tree_sampler_and_the_glt_choose_only_what_the_point_receives() {
                 ShadingContext::at(p).lit_by(mask),
                 ShadingContext::on_surface(p, r.dir()).lit_by(mask),
             ] {
-                check("importance", &importance, &lights, &ctx, &mut r);
-                check("power tree", &power, &lights, &ctx, &mut r);
-                let v = glt.light_at(p);
+                check("importance", &importance.at(&ctx), &lights, &ctx, &mut r);
+                check("power tree", &power.at(&ctx), &lights, &ctx, &mut r);
+                let v = glt.vertex(&ctx).unwrap();
                 check("trained GLT", &v, &lights, &ctx, &mut r);
-                let v = fresh.light_at(p);
+                let v = fresh.vertex(&ctx).unwrap();
                 check("untrained GLT", &v, &lights, &ctx, &mut r);
             }
         }
@@ -129,13 +130,8 @@ fn every_strategy_chooses_only_what_the_point_receives() {
         for _ in 0..10 {
             let p = r.point(50.0);
             for mask in [0b01u64, 0b10, 0b100, 0, u64::MAX] {
-                check(
-                    name,
-                    &s,
-                    &lights,
-                    &ShadingContext::at(p).lit_by(mask),
-                    &mut r,
-                );
+                let ctx = ShadingContext::at(p).lit_by(mask);
+                check(name, &s.at(&ctx), &lights, &ctx, &mut r);
             }
         }
     }
@@ -150,14 +146,13 @@ fn the_restricted_glt_draws_what_its_pmf_says() {
     let tree = LightTree::build(lights.as_slice(), BuildHeuristic::Sarh).unwrap();
     let glt = trained_glt(&tree, &lights);
     let p = Vec3::new(5.0, -3.0, 12.0);
-    let v = glt.light_at(p);
-    let ctx = ShadingContext::at(p).lit_by(0b10);
-    let (_, z) = emitter_draws(&v, &ctx, lights.len(), 200_000, &mut Rand::new(114));
+    let v = glt.vertex(&ShadingContext::at(p).lit_by(0b10)).unwrap();
+    let (_, z) = emitter_draws(&v, lights.len(), 200_000, &mut Rand::new(114));
     assert!(z < 4.0, "chi-square z {z}");
-    let all = ShadingContext::at(p);
+    let all = glt.light_at(p);
     let only_set_0 = (0..lights.len()).filter(|i| i % 4 == 0);
     let outside: f64 = only_set_0
-        .map(|i| v.pmf_exact(&all, LightId::Emitter(i as u32)))
+        .map(|i| all.pmf_exact(LightId::Emitter(i as u32)))
         .sum();
     assert!(outside > 0.05, "the control: {outside}");
 }
@@ -182,7 +177,7 @@ fn receiving_every_set_is_having_no_sets() {
         );
         for e in 0..lights.len() as u32 {
             let id = LightId::Emitter(e);
-            assert_eq!(va.pmf(&ctx, id).to_bits(), vb.pmf(&ctx, id).to_bits());
+            assert_eq!(va.pmf(id).to_bits(), vb.pmf(id).to_bits());
             assert_eq!(ia.pmf(&ctx, id).to_bits(), ib.pmf(&ctx, id).to_bits());
         }
     }
@@ -341,6 +336,6 @@ fn emitters_that_name_no_set_are_in_every_set() {
             let id = LightId::Emitter(e);
             assert_eq!(s.pmf(&one, id).to_bits(), s.pmf(&all, id).to_bits());
         }
-        check("plain emitters", &s, &plain.0, &one, &mut r);
+        check("plain emitters", &s.at(&one), &plain.0, &one, &mut r);
     }
 }

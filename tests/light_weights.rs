@@ -77,7 +77,7 @@ fn the_weighted_uniform_sampler_draws_what_its_pmf_says() {
     let lights = weighted_scene();
     let s = UniformSampler::weighted(lights.as_slice());
     let ctx = ShadingContext::at(Vec3::ZERO);
-    let (counts, z) = emitter_draws(&s, &ctx, lights.len(), 200_000, &mut Rand::new(92));
+    let (counts, z) = emitter_draws(&s.at(&ctx), lights.len(), 200_000, &mut Rand::new(92));
     assert!(z < 4.0, "chi-square z {z}");
     for (i, e) in lights.iter().enumerate() {
         if e.weight == 0.0 {

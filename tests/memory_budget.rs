@@ -6,7 +6,7 @@
 //! of the same records does exceed it, so the bound is not vacuous.
 
 mod common;
-use common::{ByPosition, LightsAt};
+use common::LightsAt;
 
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
@@ -15,16 +15,16 @@ use guiding::field::{FieldConfig, GuidingField};
 use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::sd_tree::{SdTree, SdTreeConfig};
-use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
+use guiding::{Emitter, LightChoice, LightId, LightTree, ShadingContext};
 
 /// A light at `p` chosen by `sampler`, and its splat value.
 fn light_record(
-    sampler: &impl LightSampler,
+    lights_here: &impl LightChoice,
     lights: &[Emitter],
     p: Vec3,
     rng: &mut Rand,
 ) -> (LightId, f32) {
-    let s = sampler.sample(&ShadingContext::at(p), rng.f()).unwrap();
+    let s = lights_here.sample(rng.f()).unwrap();
     let LightId::Emitter(e) = s.light else {
         panic!("no unbounded lights")
     };
@@ -61,7 +61,7 @@ fn train_glt(lights: &[Emitter], tree: &LightTree, max_bytes: Option<usize>) -> 
     for _ in 0..5 {
         for _ in 0..20_000 {
             let p = rng.point(9.5);
-            let (light, v) = light_record(&ByPosition(&glt), lights, p, &mut rng);
+            let (light, v) = light_record(&glt.light_at(p), lights, p, &mut rng);
             glt.record_light_at(p, light, v);
         }
         glt.refine();
@@ -69,10 +69,8 @@ fn train_glt(lights: &[Emitter], tree: &LightTree, max_bytes: Option<usize>) -> 
         for cell in glt.spatial().data_slice() {
             assert!(cell.cut().check(tree).is_ok());
         }
-        let ctx = ShadingContext::at(rng.point(9.0));
-        let total: f64 = (0..80)
-            .map(|e| ByPosition(&glt).pmf_exact(&ctx, LightId::Emitter(e)))
-            .sum();
+        let v = glt.light_at(rng.point(9.0));
+        let total: f64 = (0..80).map(|e| v.pmf_exact(LightId::Emitter(e))).sum();
         assert!((total - 1.0).abs() < 1e-6);
     }
     after

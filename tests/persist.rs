@@ -8,6 +8,7 @@ use common::{ByPosition, LightsAt};
 
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
+use guiding::LightChoice;
 use guiding::cut::CutConfig;
 use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
@@ -515,7 +516,7 @@ mod sd_and_field {
                 for _ in 0..4000 {
                     let p = rng.point(9.5);
                     let v = field.vertex(&ShadingContext::at(p)).unwrap();
-                    let x = v.light.sample(&ShadingContext::at(p), rng.f()).unwrap();
+                    let x = v.light.sample(rng.f()).unwrap();
                     let val = match x.light {
                         LightId::Emitter(e) => value(&lights, e, p) / x.pmf,
                         LightId::Unbounded(_) => 0.5,

@@ -15,7 +15,7 @@ use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::{ImportanceTreeSampler, UniformSampler};
 use guiding::light_tree::BuildHeuristic;
 use guiding::resampling::{Evaluated, resample};
-use guiding::{LightId, LightSampler, LightTree, ShadingContext};
+use guiding::{LightId, LightSampler, LightTree, SamplerAt, ShadingContext};
 
 /// Candidate numbers that make a uniform sampler over `n` lights draw
 /// exactly `lights`.
@@ -52,7 +52,7 @@ fn the_reservoir_keeps_each_candidate_with_its_share() {
         let mut kept = vec![0u32; lights.len()];
         for g in 0..grid {
             let u = (g as f32 + 0.5) / grid as f32;
-            let r = resample(&s, &ctx, &cands, u, None, |l, j| {
+            let r = resample(&s.at(&ctx), &cands, u, None, |l, j| {
                 assert_eq!(LightId::Emitter(lights[j]), l);
                 Some(Evaluated::new(contributions[lights[j] as usize], j))
             })
@@ -94,7 +94,7 @@ fn the_target_multiplies_the_factor() {
     let mut kept = [0u32; 4];
     for g in 0..grid {
         let u = (g as f32 + 0.5) / grid as f32;
-        let r = resample(&s, &ctx, &cands, u, None, |_, j| {
+        let r = resample(&s.at(&ctx), &cands, u, None, |_, j| {
             let mut e = Evaluated::new(contributions[j], j);
             e.factor = factors[j];
             Some(e)
@@ -122,19 +122,19 @@ fn a_weight_outside_f32_is_no_choice() {
     // u = 0 keeps the last candidate offered; its target is 1e60 times
     // below the total: the weight overflows.
     let huge_then_tiny = [1e30f32, 1e-30];
-    let r = resample(&s, &ctx, &cands, 0.0, None, |_, j| {
+    let r = resample(&s.at(&ctx), &cands, 0.0, None, |_, j| {
         Some(Evaluated::new(huge_then_tiny[j], j))
     });
     assert!(r.is_none(), "{:?}", r.map(|r| r.weight));
     // The control: the same candidates the other way round keep a finite
     // weight.
-    let r = resample(&s, &ctx, &cands, 0.0, None, |_, j| {
+    let r = resample(&s.at(&ctx), &cands, 0.0, None, |_, j| {
         Some(Evaluated::new(huge_then_tiny[1 - j], j))
     })
     .unwrap();
     assert!(r.weight > 0.0 && r.weight.is_finite());
     // A BSDF density 1e60 times the light's: the weight underflows.
-    let r = resample(&s, &ctx, &cands[..1], 0.0, None, |_, j| {
+    let r = resample(&s.at(&ctx), &cands[..1], 0.0, None, |_, j| {
         Some(Evaluated::new(1.0, j).with_densities(1e-30, 1e30))
     });
     assert!(r.is_none(), "{:?}", r.map(|r| r.weight));
@@ -151,7 +151,7 @@ fn one_candidate_is_plain_sampling() {
         let ctx = ShadingContext::at(rng.point(9.0));
         let u = rng.f();
         let plain = s.sample(&ctx, u).unwrap();
-        let r = resample(&s, &ctx, &[u], rng.f(), None, |_, _| {
+        let r = resample(&s.at(&ctx), &[u], rng.f(), None, |_, _| {
             Some(Evaluated::new(2.5, ()))
         })
         .unwrap();
@@ -194,7 +194,7 @@ fn estimate(
     let mut cands = vec![0.0f32; m];
     for _ in 0..n {
         cands.iter_mut().for_each(|c| *c = rng.f());
-        let r = resample(s, &ctx, &cands, rng.f(), None, |l, _| {
+        let r = resample(&SamplerAt::new(s, &ctx), &cands, rng.f(), None, |l, _| {
             let LightId::Emitter(e) = l else { return None };
             Some(Evaluated {
                 factor: factor(e),
@@ -303,13 +303,13 @@ fn bad_evaluations_are_ignored() {
         Some(f32::INFINITY),
     ];
     for b in bad {
-        let none = resample(&s, &ctx, &cands, 0.5, None, |_, _| {
+        let none = resample(&s.at(&ctx), &cands, 0.5, None, |_, _| {
             b.map(|c| Evaluated::new(c, ()))
         });
         assert!(none.is_none(), "{b:?}");
     }
     for u in [0.0, 0.3, 0.7, 0.999_999] {
-        let r = resample(&s, &ctx, &cands, u, None, |l, j| {
+        let r = resample(&s.at(&ctx), &cands, u, None, |l, j| {
             let c = if j == 2 {
                 1.0
             } else {
@@ -326,7 +326,7 @@ fn bad_evaluations_are_ignored() {
         assert!((r.weight - 1.0).abs() < 1e-6, "{}", r.weight);
     }
     assert!(
-        resample(&s, &ctx, &[], 0.5, None, |_, _| Some(Evaluated::new(
+        resample(&s.at(&ctx), &[], 0.5, None, |_, _| Some(Evaluated::new(
             1.0,
             ()
         )))
@@ -345,19 +345,19 @@ fn bad_evaluations_are_ignored() {
     ];
     let evaluated = |(pl, pb): (f32, f32)| Evaluated::new(1.0, ()).with_densities(pl, pb);
     for d in densities {
-        let light = resample(&s, &ctx, &cands, 0.5, None, |_, _| Some(evaluated(d)));
+        let light = resample(&s.at(&ctx), &cands, 0.5, None, |_, _| Some(evaluated(d)));
         assert!(light.is_none(), "{d:?}");
     }
     // A BSDF candidate without a BSDF density is ignored too.
     for d in densities.into_iter().chain([(1.0, 0.0)]) {
         let bsdf = Some((LightId::Emitter(1), evaluated(d)));
-        let found = resample(&s, &ctx, &[], 0.5, bsdf, |_, _| None);
+        let found = resample(&s.at(&ctx), &[], 0.5, bsdf, |_, _| None);
         assert!(found.is_none(), "{d:?}");
         // Beside light candidates (whose weights would make it count).
         for u in [0.1, 0.5, 0.9] {
             let light = |_, _| Some(Evaluated::new(1.0, ()));
-            let with = resample(&s, &ctx, &cands, u, bsdf, light);
-            assert_eq!(with, resample(&s, &ctx, &cands, u, None, light), "{d:?}");
+            let with = resample(&s.at(&ctx), &cands, u, bsdf, light);
+            assert_eq!(with, resample(&s.at(&ctx), &cands, u, None, light), "{d:?}");
         }
     }
 }
@@ -400,7 +400,7 @@ fn resampled_mis_is_unbiased() {
         // Light sample: uniform on the light (pdf 1).
         let ys: Vec<f32> = (0..cands.len()).map(|_| rng.f()).collect();
         let mut x = 0.0f64;
-        if let Some(r) = resample(&s, &ctx, &cands, rng.f(), None, |l, j| {
+        if let Some(r) = resample(&s.at(&ctx), &cands, rng.f(), None, |l, j| {
             let LightId::Emitter(k) = l else { return None };
             let y = k as f32 + ys[j];
             Some(Evaluated::new(radiance(k, y), (k, y)))
@@ -481,7 +481,7 @@ fn the_bsdf_sample_as_a_candidate_is_unbiased() {
                 let e = Evaluated::new(radiance(k, y) / pl, (k, y)).with_densities(pl, pdf_bsdf(y));
                 (LightId::Emitter(k), e)
             });
-            let r = resample(s, &ctx, &cands, rng.f(), bsdf, |l, j| {
+            let r = resample(&SamplerAt::new(s, &ctx), &cands, rng.f(), bsdf, |l, j| {
                 let LightId::Emitter(k) = l else { return None };
                 let y = k as f32 + ys[j];
                 let pl = density(warp, ys[j]);
@@ -551,8 +551,8 @@ fn resampling_is_deterministic() {
             let LightId::Emitter(e) = l else { return None };
             Some(Evaluated::new(unshadowed(&lights, e, p), e))
         };
-        let a = resample(&s, &ctx, &cands, u, None, eval).unwrap();
-        let b = resample(&s, &ctx, &cands, u, None, eval).unwrap();
+        let a = resample(&s.at(&ctx), &cands, u, None, eval).unwrap();
+        let b = resample(&s.at(&ctx), &cands, u, None, eval).unwrap();
         assert_eq!(a, b);
     }
 }

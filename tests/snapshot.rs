@@ -11,32 +11,45 @@ use guiding::cut::{BelowCut, CutConfig, Modulation, Prior};
 use guiding::glt::Glt;
 use guiding::snapshot::{SnapshotArrays, SnapshotError, SnapshotView};
 use guiding::{
-    Aabb, BuildHeuristic, Emitter, GltConfig, LightHierarchy, LightId, LightSample, LightSampler,
-    LightTree, ShadingContext, UnboundedLights,
+    Aabb, BuildHeuristic, Emitter, GltConfig, LightChoice, LightHierarchy, LightId, LightTree,
+    ShadingContext, UnboundedLights,
 };
 use proptest::prelude::*;
 
-/// The snapshot's sampler behind the crate's sampler interface, so the
-/// shared checks (chi-square draws) run on it. Contexts carry only a
-/// position and a normal here (a snapshot has no light linking).
-struct Sampler<'a>(SnapshotView<'a>);
+/// A draw from a snapshot: the light, its pmf and the learned visibility
+/// of the cluster it was chosen from (what the WGSL kernel returns).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Draw {
+    light: LightId,
+    pmf: f32,
+    visibility: f32,
+}
 
-impl LightSampler for Sampler<'_> {
-    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
-        let s = self.0.sample(ctx.position, ctx.normal, u)?;
-        Some(LightSample {
-            light: s.light,
-            pmf: s.pmf,
-        })
+/// The context of a point with exactly this normal (the GPU gets the
+/// same words).
+fn context(p: Vec3, normal: Option<Vec3>) -> ShadingContext {
+    ShadingContext {
+        normal,
+        ..ShadingContext::at(p)
     }
+}
 
-    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        self.0.pmf(ctx.position, ctx.normal, light)
-    }
+/// The snapshot's vertex at `p` and its draw of `u`, with the visibility.
+fn draw(view: &SnapshotView, p: Vec3, normal: Option<Vec3>, u: f32) -> Option<Draw> {
+    let (s, visibility) = view
+        .vertex(&context(p, normal))?
+        .sample_with_visibility(u)?;
+    Some(Draw {
+        light: s.light,
+        pmf: s.pmf,
+        visibility,
+    })
+}
 
-    fn is_empty(&self) -> bool {
-        false
-    }
+/// The snapshot's vertex at `p` and its pmf of `light` (0 with no vertex).
+fn pmf(view: &SnapshotView, p: Vec3, normal: Option<Vec3>, light: LightId) -> f32 {
+    view.vertex(&context(p, normal))
+        .map_or(0.0, |v| v.pmf(light))
 }
 
 /// Visibility of light `e` from `p`: a wall at `x = 0` hides lights on
@@ -62,7 +75,7 @@ fn train<H: LightHierarchy>(
             let Some(vertex) = glt.vertex(&ctx) else {
                 continue;
             };
-            let Some(s) = vertex.sample(&ctx, r.f()) else {
+            let Some(s) = vertex.sample(r.f()) else {
                 continue;
             };
             let (unshadowed, seen) = match s.light {
@@ -175,7 +188,7 @@ fn agreement(glt: &Glt<LightTree>, view: &SnapshotView, queries: usize, seed: u6
             panic!("{p} is in the scene")
         };
         let cpu = rules.sample_with_visibility(v.cut(), &ctx, u);
-        let snap = view.sample(p, n_ctx, u);
+        let snap = draw(view, p, n_ctx, u);
         match (cpu, snap) {
             (Some((c, cv)), Some(s)) if c.light == s.light => {
                 a.same += 1;
@@ -188,9 +201,8 @@ fn agreement(glt: &Glt<LightTree>, view: &SnapshotView, queries: usize, seed: u6
                 // within `tau` of `u` (searched in steps finer than that
                 // light's pmf, up to 1e-5).
                 let step = s.map_or(1e-8, |s| (f64::from(s.pmf) / 2.0).clamp(1e-10, 1e-8));
-                let chooses = |d: f64| {
-                    v.sample_exact(&ctx, f64::from(u) + d).map(|x| x.0) == s.map(|s| s.light)
-                };
+                let chooses =
+                    |d: f64| v.sample_exact(f64::from(u) + d).map(|x| x.0) == s.map(|s| s.light);
                 let tau = (1..)
                     .map(|k| k as f64 * step)
                     .take_while(|&t| t <= 1e-5)
@@ -204,7 +216,7 @@ fn agreement(glt: &Glt<LightTree>, view: &SnapshotView, queries: usize, seed: u6
         };
         let exact = rules.pmf_exact(v.cut(), &ctx, light);
         if exact > 1e-30 {
-            a.evaluated = a.evaluated.max(relative(view.pmf(p, n_ctx, light), exact));
+            a.evaluated = a.evaluated.max(relative(pmf(view, p, n_ctx, light), exact));
         }
     }
     a
@@ -245,14 +257,14 @@ fn check_distribution(
     let pmfs: Vec<f32> = (0..lights)
         .map(LightId::Emitter)
         .chain((0..unbounded).map(LightId::Unbounded))
-        .map(|l| view.pmf(p, n, l))
+        .map(|l| pmf(view, p, n, l))
         .collect();
     assert!(pmfs.iter().all(|x| x.is_finite() && *x >= 0.0), "{pmfs:?}");
     let total: f64 = pmfs.iter().map(|&x| f64::from(x)).sum();
     assert!((total - 1.0).abs() < 1e-5, "sums to {total} at {p}");
     for _ in 0..50 {
-        let s = view.sample(p, n, r.f()).expect("a light");
-        assert_eq!(s.pmf.to_bits(), view.pmf(p, n, s.light).to_bits(), "{s:?}");
+        let s = draw(view, p, n, r.f()).expect("a light");
+        assert_eq!(s.pmf.to_bits(), pmf(view, p, n, s.light).to_bits(), "{s:?}");
         assert!(s.pmf > 0.0 && (0.0..=1.0).contains(&s.visibility), "{s:?}");
     }
 }
@@ -299,13 +311,14 @@ proptest! {
 fn draws_follow_the_snapshots_pmf() {
     let (lights, glt) = trained(300, rule_sets()[0].1, 3);
     let snapshot = glt.snapshot().unwrap();
-    let sampler = Sampler(snapshot.view());
+    let view = snapshot.view();
     let mut r = Rand::new(8);
     for _ in 0..5 {
         let ctx = ShadingContext::on_surface(r.point(50.0), r.dir());
+        let sampler = view.vertex(&ctx).unwrap();
         let mut counts = vec![0u64; lights.len() + 2];
         for _ in 0..200_000 {
-            let s = sampler.sample(&ctx, r.f()).unwrap();
+            let s = sampler.sample(r.f()).unwrap();
             let i = match s.light {
                 LightId::Emitter(e) => e as usize,
                 LightId::Unbounded(i) => lights.len() + i as usize,
@@ -315,7 +328,7 @@ fn draws_follow_the_snapshots_pmf() {
         let probs: Vec<f64> = (0..lights.len() as u32)
             .map(LightId::Emitter)
             .chain((0..2).map(LightId::Unbounded))
-            .map(|l| f64::from(sampler.pmf(&ctx, l)))
+            .map(|l| f64::from(sampler.pmf(l)))
             .collect();
         let (z, _) = chi_square_z(&counts, &probs).expect("no draw of pmf 0");
         assert!(z < common::Z_P_1E4, "z = {z} at {}", ctx.position);
@@ -380,11 +393,11 @@ fn hard_scenes_stay_distributions() {
                 }
             }
             for bad in [Vec3::NAN, Vec3::new(0.0, f32::INFINITY, 0.0)] {
-                assert_eq!(view.sample(bad, None, 0.5), None, "{name}");
-                assert_eq!(view.pmf(bad, None, LightId::Emitter(0)), 0.0, "{name}");
+                assert_eq!(draw(&view, bad, None, 0.5), None, "{name}");
+                assert_eq!(pmf(&view, bad, None, LightId::Emitter(0)), 0.0, "{name}");
             }
             if name == "one light" {
-                let s = view.sample(Vec3::ZERO, None, 0.99).unwrap();
+                let s = draw(&view, Vec3::ZERO, None, 0.99).unwrap();
                 assert_eq!((s.light, s.pmf), (LightId::Emitter(0), 1.0));
             }
         }
@@ -400,9 +413,9 @@ fn a_dark_scene_chooses_nothing() {
     let glt = Glt::new(&tree, scene, GltConfig::default()).unwrap();
     let snapshot = glt.snapshot().unwrap();
     let view = snapshot.view();
-    assert_eq!(view.sample(Vec3::ZERO, Some(Vec3::Y), 0.5), None);
+    assert_eq!(draw(&view, Vec3::ZERO, Some(Vec3::Y), 0.5), None);
     for e in 0..4 {
-        assert_eq!(view.pmf(Vec3::ZERO, None, LightId::Emitter(e)), 0.0);
+        assert_eq!(pmf(&view, Vec3::ZERO, None, LightId::Emitter(e)), 0.0);
     }
 }
 
@@ -556,12 +569,12 @@ proptest! {
         let mut r = Rand::new(seed);
         for _ in 0..20 {
             let (p, n) = (r.point(70.0), r.dir());
-            if let Some(s) = view.sample(p, Some(n), r.f()) {
+            if let Some(s) = draw(&view, p, Some(n), r.f()) {
                 prop_assert!(s.pmf > 0.0 && s.pmf <= 1.0001, "{s:?}");
             }
             for e in 0..45 {
                 let light = if e < 40 { LightId::Emitter(e) } else { LightId::Unbounded(e - 40) };
-                let pmf = view.pmf(p, Some(n), light);
+                let pmf = pmf(&view, p, Some(n), light);
                 prop_assert!((0.0..=1.0001).contains(&pmf), "{pmf}");
             }
         }
@@ -599,14 +612,14 @@ fn a_deep_chain_is_sampled_in_distribution() {
         let snapshot = glt.snapshot().unwrap();
         let view = snapshot.view();
         let pmf: Vec<f64> = (0..n)
-            .map(|k| f64::from(view.pmf(p, None, LightId::Emitter(k))))
+            .map(|k| f64::from(pmf(&view, p, None, LightId::Emitter(k))))
             .collect();
         assert!((pmf.iter().sum::<f64>() - 1.0).abs() < 1e-5);
         assert!(pmf[99] > 1e-4, "{}", pmf[99]);
         let mut counts = vec![0u64; n as usize];
         let mut r = Rand::new(99);
         for _ in 0..200_000 {
-            let s = view.sample(p, None, r.f()).unwrap();
+            let s = draw(&view, p, None, r.f()).unwrap();
             let LightId::Emitter(e) = s.light else {
                 panic!()
             };
@@ -634,7 +647,7 @@ fn a_fields_snapshot_chooses_as_the_field() {
             let Some(v) = field.vertex(&ctx) else {
                 continue;
             };
-            let Some(s) = v.light.sample(&ctx, r.f()) else {
+            let Some(s) = v.light.sample(r.f()) else {
                 continue;
             };
             if let LightId::Emitter(e) = s.light {
@@ -650,8 +663,8 @@ fn a_fields_snapshot_chooses_as_the_field() {
     for _ in 0..queries {
         let ctx = ShadingContext::on_surface(r.point(58.0), r.dir());
         let u = r.f();
-        let cpu = field.vertex(&ctx).and_then(|v| v.light.sample(&ctx, u));
-        let snap = view.sample(ctx.position, ctx.normal, u);
+        let cpu = field.vertex(&ctx).and_then(|v| v.light.sample(u));
+        let snap = draw(&view, ctx.position, ctx.normal, u);
         match (cpu, snap) {
             (Some(c), Some(s)) if c.light == s.light => {
                 same += 1;
@@ -683,7 +696,7 @@ fn the_snapshots_estimates_are_unbiased() {
         let draws = 400_000;
         let (mut sum, mut sum2) = (0.0f64, 0.0f64);
         for _ in 0..draws {
-            let s = view.sample(ctx.position, ctx.normal, r.f()).unwrap();
+            let s = draw(&view, ctx.position, ctx.normal, r.f()).unwrap();
             let LightId::Emitter(e) = s.light else {
                 panic!("no unbounded light")
             };
@@ -739,7 +752,7 @@ fn the_numbers_edges() {
             let snapshot = glt.snapshot().unwrap();
             let view = snapshot.view();
             let p = Vec3::new(0.0, 2.0, 0.0);
-            let at = |u: f32| view.sample(p, Some(Vec3::Y), u);
+            let at = |u: f32| draw(&view, p, Some(Vec3::Y), u);
             for u in [f32::NAN, -1.0, -0.0, f32::NEG_INFINITY] {
                 assert_eq!(at(u), at(0.0), "u = {u}");
             }

@@ -7,6 +7,7 @@
 
 mod common;
 use common::{ByPosition, LightsAt};
+use guiding::LightChoice;
 use guiding::RecordOutcome;
 
 use common::{Rand, scene, two_rooms, unshadowed, value};
@@ -58,12 +59,11 @@ fn trained(visibility: bool) -> Glt<&'static LightTree> {
 }
 
 /// Mean learned visibility of each room's lights seen from `p`.
-fn room_visibility(glt: &impl LightSampler, p: Vec3) -> (f32, f32) {
+fn room_visibility(glt: &impl LightChoice, p: Vec3) -> (f32, f32) {
     let lights = two_rooms();
-    let ctx = ShadingContext::at(p);
     let (mut own, mut other) = (Vec::new(), Vec::new());
     for e in 0..lights.len() as u32 {
-        let v = glt.visibility(&ctx, LightId::Emitter(e));
+        let v = glt.visibility(LightId::Emitter(e));
         assert!((1.0 / 64.0..=1.0).contains(&v), "{v}");
         if (lights[e as usize].bounds.center().x < 0.0) == (p.x < 0.0) {
             own.push(v);
@@ -91,7 +91,10 @@ fn each_room_learns_the_other_is_hidden() {
 #[test]
 fn off_by_default() {
     let glt = trained(false);
-    let (own, other) = room_visibility(&ByPosition(&glt), Vec3::new(-5.0, 1.0, 2.0));
+    let (own, other) = room_visibility(
+        &glt.light_at(Vec3::new(-5.0, 1.0, 2.0)),
+        Vec3::new(-5.0, 1.0, 2.0),
+    );
     assert_eq!((own, other), (1.0, 1.0));
     assert_eq!(
         glt.record_visibility_at(Vec3::ZERO, LightId::Emitter(0), 0.5, 1.0),
@@ -162,8 +165,8 @@ fn visibility_survives_saving_loading_and_merging() {
     b.refine();
     let q = Vec3::new(-5.0, 1.0, 2.0);
     assert_eq!(
-        room_visibility(&ByPosition(&a), q),
-        room_visibility(&ByPosition(&b), q)
+        room_visibility(&a.light_at(q), q),
+        room_visibility(&b.light_at(q), q)
     );
 }
 
@@ -177,9 +180,8 @@ fn resampling_with_learned_visibility_is_unbiased_and_better() {
     let seeing = trained(true);
     let blind = trained(false);
     let p = Vec3::new(-0.5, 1.0, 2.0);
-    let ctx = ShadingContext::at(p);
     let truth: f64 = (0..80).map(|e| f64::from(value(&lights, e, p))).sum();
-    let run = |s: &dyn LightSampler| {
+    let run = |s: &dyn LightChoice| {
         let mut rng = Rand::new(77);
         let n = 100_000;
         let (mut s1, mut s2) = (0.0f64, 0.0f64);
@@ -194,7 +196,7 @@ fn resampling_with_learned_visibility_is_unbiased_and_better() {
                 rng.f(),
                 rng.f(),
             ];
-            let x = resample(s, &ctx, &cands, rng.f(), None, |l, _| {
+            let x = resample(s, &cands, rng.f(), None, |l, _| {
                 let LightId::Emitter(e) = l else { return None };
                 Some(Evaluated::new(unshadowed(&lights, e, p), e))
             })
@@ -208,8 +210,8 @@ fn resampling_with_learned_visibility_is_unbiased_and_better() {
         let var = s2 / n as f64 - mean * mean;
         (mean, (var / n as f64).sqrt(), var)
     };
-    let (m1, se1, v1) = run(&ByPosition(&seeing));
-    let (m0, se0, v0) = run(&ByPosition(&blind));
+    let (m1, se1, v1) = run(&seeing.light_at(p));
+    let (m0, se0, v0) = run(&blind.light_at(p));
     assert!((m1 - truth).abs() < 4.5 * se1, "{m1} +- {se1} vs {truth}");
     assert!((m0 - truth).abs() < 4.5 * se0, "{m0} +- {se0} vs {truth}");
     assert!(v1 < 0.8 * v0, "learned visibility {v1}, blind {v0}");
@@ -253,8 +255,8 @@ fn sampling_with_visibility_equals_sampling_then_visibility() {
             let ctx = ShadingContext::on_surface(p, Vec3::Y);
             let u = rng.f();
             let s = glt.vertex(&ctx).unwrap();
-            let want = s.sample(&ctx, u).map(|x| (x, s.visibility(&ctx, x.light)));
-            let got = s.sample_with_visibility(&ctx, u);
+            let want = s.sample(u).map(|x| (x, s.visibility(x.light)));
+            let got = s.sample_with_visibility(u);
             assert_eq!(
                 got.map(|(x, v)| (x, v.to_bits())),
                 want.map(|(x, v)| (x, v.to_bits())),

@@ -16,7 +16,7 @@
 mod common;
 
 use guiding::glam::Vec3;
-use guiding::{LightSampler, ShadingContext};
+use guiding::{LightChoice, ShadingContext};
 use guiding_gpu::{Gpu, GpuSampler};
 use std::time::{Duration, Instant};
 
@@ -82,7 +82,7 @@ fn main() {
                 normal: Some(Vec3::from_array(q.n)),
                 ..ShadingContext::at(Vec3::from_array(q.p))
             };
-            if let Some(s) = glt.vertex(&ctx).and_then(|v| v.sample(&ctx, q.u)) {
+            if let Some(s) = glt.vertex(&ctx).and_then(|v| v.sample(q.u)) {
                 sum += s.pmf;
             }
         }
@@ -96,7 +96,11 @@ fn main() {
     let cpu_snap = median(|| {
         let mut sum = 0.0f32;
         for q in &queries {
-            if let Some(s) = view.sample(Vec3::from_array(q.p), Some(Vec3::from_array(q.n)), q.u) {
+            let ctx = ShadingContext {
+                normal: Some(Vec3::from_array(q.n)),
+                ..ShadingContext::at(Vec3::from_array(q.p))
+            };
+            if let Some(s) = view.vertex(&ctx).and_then(|v| v.sample(q.u)) {
                 sum += s.pmf;
             }
         }

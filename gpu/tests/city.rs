@@ -6,7 +6,7 @@
 mod common;
 
 use common::{compare, context, glt_answers};
-use guiding::{Glt, LightSampler, LightTree};
+use guiding::{Glt, LightChoice, LightTree};
 use guiding_gpu::{Answer, Gpu, GpuSampler, Query};
 
 /// For each query where the snapshot chose another light than the GLT,
@@ -27,7 +27,7 @@ fn boundary_distances(
         let ctx = context(q);
         let v = glt.vertex(&ctx).expect("a cell");
         let chooses = |d: f64| {
-            v.sample_exact(&ctx, f64::from(q.u) + d)
+            v.sample_exact(f64::from(q.u) + d)
                 .is_some_and(|(l, _)| Query::light_word(l) == s.light)
         };
         let step = (f64::from(s.pmf) / 2.0).clamp(1e-10, 1e-8);

@@ -7,7 +7,7 @@ use super::guiding_cut::GuidingCut;
 use super::octants::{OctantSplats, octant_of};
 use crate::dropped::{DropCounters, DropReason};
 use crate::light_sampler::ShadingContext;
-use crate::light_sampler::{LightId, LightSample, LightSampler};
+use crate::light_sampler::{LightChoice, LightId, LightSample};
 use crate::light_tree::LightHierarchy;
 use crate::math::Aabb;
 use crate::record::RecordOutcome;
@@ -47,18 +47,18 @@ pub(crate) fn light_salt(light: LightId) -> [u32; 3] {
 /// lookup, sampled by the GLT's sampling rule (`src/cut/sampling.rs`), and
 /// the records that teach it.
 ///
-/// It is a [`LightSampler`]: `sample` and `pmf` answer for the located
-/// cell's cut whatever `ctx.position` is (`ctx` feeds the importance rules
-/// at the shading point; pass the context the vertex was made from). At
-/// each vertex a renderer chooses a light with `sample`, weighs BSDF
-/// samples that hit an emitter with `pmf`, and records what each light
-/// sample found with [`LightVertex::record_light`] (and, to learn each
-/// cluster's visibility, [`LightVertex::record_visibility`]).
+/// It is the [`LightChoice`] at the shading point it was made for: it
+/// keeps the context (position, normal, light links), so `sample`, `pmf`
+/// and the records take none. At each vertex a renderer chooses a light
+/// with `sample`, weighs BSDF samples that hit an emitter with `pmf`, and
+/// records what each light sample found with [`LightVertex::record_light`]
+/// (and, to learn each cluster's visibility,
+/// [`LightVertex::record_visibility`]).
 #[derive(Clone, Copy)]
 pub struct LightVertex<'a, H: LightHierarchy> {
     rules: &'a CutRules<H>,
     cut: &'a GuidingCut,
-    p: Vec3,
+    ctx: ShadingContext,
     /// The cells records go to and where the vertex is in them; `None`
     /// for a lone cut ([`CutRules::vertex`]).
     cells: Option<(&'a dyn LightCells, (CellId, Aabb))>,
@@ -67,7 +67,7 @@ pub struct LightVertex<'a, H: LightHierarchy> {
 impl<H: LightHierarchy> core::fmt::Debug for LightVertex<'_, H> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.debug_struct("LightVertex")
-            .field("position", &self.p)
+            .field("position", &self.ctx.position)
             .field("cell", &self.cells.map(|c| c.1.0))
             .field("cut", &self.cut)
             .finish_non_exhaustive()
@@ -75,18 +75,20 @@ impl<H: LightHierarchy> core::fmt::Debug for LightVertex<'_, H> {
 }
 
 impl<'a, H: LightHierarchy> LightVertex<'a, H> {
-    /// The vertex at `p`, located at `at` in `cells`, whose cut is `cut`.
+    /// The vertex for `ctx`, located at `at` in `cells`, whose cut is
+    /// `cut`.
     #[inline]
     pub(crate) fn new(
         rules: &'a CutRules<H>,
         cut: &'a GuidingCut,
-        (p, at): Located,
+        ctx: &ShadingContext,
+        at: (CellId, Aabb),
         cells: &'a dyn LightCells,
     ) -> Self {
         Self {
             rules,
             cut,
-            p,
+            ctx: *ctx,
             cells: Some((cells, at)),
         }
     }
@@ -94,7 +96,13 @@ impl<'a, H: LightHierarchy> LightVertex<'a, H> {
     /// The point this vertex was located from.
     #[inline]
     pub fn position(&self) -> Vec3 {
-        self.p
+        self.ctx.position
+    }
+
+    /// The shading context this vertex answers for.
+    #[inline]
+    pub fn context(&self) -> &ShadingContext {
+        &self.ctx
     }
 
     /// The located cell's cut.
@@ -119,8 +127,10 @@ impl<'a, H: LightHierarchy> LightVertex<'a, H> {
     #[inline]
     pub fn record_light(&self, light: LightId, value: f32) -> RecordOutcome {
         match self.cells {
-            Some((cells, at)) => cells.record_light((self.p, at), light, value),
-            None => self.rules.splat_from(self.cut, self.p, light, value),
+            Some((cells, at)) => cells.record_light((self.ctx.position, at), light, value),
+            None => self
+                .rules
+                .splat_from(self.cut, self.ctx.position, light, value),
         }
     }
 
@@ -159,7 +169,7 @@ impl<H: LightHierarchy> CutRules<H> {
         LightVertex {
             rules: self,
             cut,
-            p: ctx.position,
+            ctx: *ctx,
             cells: None,
         }
     }
@@ -203,46 +213,42 @@ impl<H: LightHierarchy> CutRules<H> {
     }
 }
 
-impl<H: LightHierarchy> LightSampler for LightVertex<'_, H> {
+impl<H: LightHierarchy> LightChoice for LightVertex<'_, H> {
     /// Applies the GLT's sampling rule with the located cell's cut.
     #[inline]
-    fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
-        self.rules.sample(self.cut, ctx, u)
+    fn sample(&self, u: f32) -> Option<LightSample> {
+        self.rules.sample(self.cut, &self.ctx, u)
     }
 
     #[inline]
-    fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        self.rules.pmf(self.cut, ctx, light)
+    fn pmf(&self, light: LightId) -> f32 {
+        self.rules.pmf(self.cut, &self.ctx, light)
     }
 
     fn is_empty(&self) -> bool {
-        self.rules.is_empty()
-    }
-
-    fn is_empty_at(&self, ctx: &ShadingContext) -> bool {
-        self.rules.is_empty_at(ctx)
+        self.rules.is_empty_at(&self.ctx)
     }
 
     #[inline]
-    fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
-        self.rules.sample_exact(self.cut, ctx, u)
+    fn sample_exact(&self, u: f64) -> Option<(LightId, f64)> {
+        self.rules.sample_exact(self.cut, &self.ctx, u)
     }
 
     #[inline]
-    fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
-        self.rules.pmf_exact(self.cut, ctx, light)
+    fn pmf_exact(&self, light: LightId) -> f64 {
+        self.rules.pmf_exact(self.cut, &self.ctx, light)
     }
 
     /// The learned visibility of `light` in the located cell (1 where
     /// none is learned).
-    fn visibility(&self, _ctx: &ShadingContext, light: LightId) -> f32 {
+    fn visibility(&self, light: LightId) -> f32 {
         self.rules.visibility(self.cut, light)
     }
 
     /// One walk: the visibility is read where it leaves the cut.
     #[inline]
-    fn sample_with_visibility(&self, ctx: &ShadingContext, u: f32) -> Option<(LightSample, f32)> {
-        self.rules.sample_with_visibility(self.cut, ctx, u)
+    fn sample_with_visibility(&self, u: f32) -> Option<(LightSample, f32)> {
+        self.rules.sample_with_visibility(self.cut, &self.ctx, u)
     }
 }
 

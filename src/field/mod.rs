@@ -60,10 +60,8 @@
 //!
 //! ```
 //! use glam::Vec3;
-//! use guiding::field::{FieldConfig, GuidingField};
-//! use guiding::light_tree::BuildHeuristic;
-//! use guiding::math::Aabb;
-//! use guiding::{Emitter, LightId, LightSampler, LightTree, ShadingContext};
+//! use guiding::{Aabb, BuildHeuristic, Emitter, FieldConfig, GuidingField, LightChoice};
+//! use guiding::{LightId, LightTree, ShadingContext};
 //!
 //! let lights = vec![
 //!     Emitter::point(Vec3::new(-3.0, 2.0, 0.0), 1.0),
@@ -83,7 +81,7 @@
 //!         let v = field.vertex(&ctx).expect("finite point");
 //!         // NEE: the light on the same side contributes, the other is
 //!         // occluded.
-//!         let s = v.light.sample(&ctx, (i % 7) as f32 / 7.0).expect("lights");
+//!         let s = v.light.sample((i % 7) as f32 / 7.0).expect("lights");
 //!         let LightId::Emitter(e) = s.light else { unreachable!() };
 //!         let seen = (e == 0) == (x.x < 0.0);
 //!         v.light.record_light(s.light, if seen { 1.0 / s.pmf } else { 0.0 });
@@ -94,7 +92,7 @@
 //! }
 //! let ctx = ShadingContext::at(Vec3::new(-3.0, 0.0, 0.0));
 //! let v = field.vertex(&ctx).unwrap();
-//! assert!(v.light.pmf(&ctx, LightId::Emitter(0)) > 0.85);
+//! assert!(v.light.pmf(LightId::Emitter(0)) > 0.85);
 //! let d = v.direction;
 //! assert!(d.direction_pdf(Vec3::Y) > 4.0 * d.direction_pdf(-Vec3::Y));
 //! let (dir, pdf) = d.sample_direction([0.3, 0.6]);

@@ -39,7 +39,7 @@ impl<H: LightHierarchy> GuidingField<H> {
         let cell: &FieldCell = self.cells.data(at.0);
         Some(FieldVertex {
             direction: DirectionVertex::new(&self.sd, &cell.sd, (p, at), self),
-            light: LightVertex::new(&self.guide, &cell.cut, (p, at), self),
+            light: LightVertex::new(&self.guide, &cell.cut, ctx, at, self),
         })
     }
 }

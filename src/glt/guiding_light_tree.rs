@@ -255,20 +255,20 @@ impl<H: LightHierarchy> Glt<H> {
     /// there).
     #[inline]
     pub fn vertex(&self, ctx: &ShadingContext) -> Option<LightVertex<'_, H>> {
-        let Some(v) = self.vertex_uncounted(ctx.position) else {
+        let Some(v) = self.vertex_uncounted(ctx) else {
             self.dropped.count(DropReason::Position);
             return None;
         };
         Some(v)
     }
 
-    /// [`Glt::vertex`] at `p` without counting a non-finite `p` (for
+    /// [`Glt::vertex`] without counting a non-finite position (for
     /// [`Strategy`](crate::Strategy)'s queries by position).
     #[inline]
-    pub(crate) fn vertex_uncounted(&self, p: Vec3) -> Option<LightVertex<'_, H>> {
-        let at = self.spatial.locate_with_bounds(p)?;
+    pub(crate) fn vertex_uncounted(&self, ctx: &ShadingContext) -> Option<LightVertex<'_, H>> {
+        let at = self.spatial.locate_with_bounds(ctx.position)?;
         let cut = &self.spatial.data(at.0).cut;
-        Some(LightVertex::new(&self.guide, cut, (p, at), self))
+        Some(LightVertex::new(&self.guide, cut, ctx, at, self))
     }
 }
 

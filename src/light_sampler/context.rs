@@ -59,8 +59,7 @@ impl ShadingContext {
     /// (an object's light linking).
     ///
     /// ```
-    /// use guiding::light_sampler::PowerSampler;
-    /// use guiding::{glam::Vec3, Emitter, LightId, LightSampler, ShadingContext};
+    /// use guiding::{glam::Vec3, Emitter, LightId, LightSampler, PowerSampler, ShadingContext};
     /// let lamps = [
     ///     Emitter::point(Vec3::ZERO, 1.0).in_light_sets(0b01),
     ///     Emitter::point(Vec3::X, 3.0).in_light_sets(0b10),

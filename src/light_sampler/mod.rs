@@ -15,6 +15,7 @@
 //! | [`WithUnbounded`] | any of the above plus the scene's unbounded lights (distant, infinite) with a fixed probability |
 //! | [`crate::glt`] | the Guiding Light Tree: learned cuts, then the light tree |
 
+mod choice;
 mod context;
 mod importance;
 mod power;
@@ -24,6 +25,7 @@ mod tree_walk;
 mod unbounded;
 mod uniform;
 
+pub use choice::{LightChoice, SamplerAt};
 pub use context::ShadingContext;
 pub(crate) use importance::BACK_FACTOR;
 pub use importance::importance;
@@ -161,6 +163,33 @@ pub trait LightSampler {
     fn sample_with_visibility(&self, ctx: &ShadingContext, u: f32) -> Option<(LightSample, f32)> {
         let s = self.sample(ctx, u)?;
         Some((s, self.visibility(ctx, s.light)))
+    }
+
+    /// The sampler at one shading point: a [`LightChoice`] whose queries
+    /// take no context, the shape a guide's vertex has, so one integrator
+    /// drives both. (A `dyn LightSampler` makes its own with
+    /// [`SamplerAt::new`].)
+    #[inline]
+    fn at(&self, ctx: &ShadingContext) -> SamplerAt<'_, Self>
+    where
+        Self: Sized,
+    {
+        SamplerAt::new(self, ctx)
+    }
+
+    /// [`LightSampler::sample`] with the number drawn from a renderer's
+    /// generator ([`rand_core::Rng`]): one `next_u32`, its top 24 bits
+    /// times `2^-24`, so the choice equals `sample` of that number.
+    #[inline]
+    fn sample_with<R: rand_core::Rng + ?Sized>(
+        &self,
+        ctx: &ShadingContext,
+        rng: &mut R,
+    ) -> Option<LightSample>
+    where
+        Self: Sized,
+    {
+        self.sample(ctx, crate::math::unit_f32(rng))
     }
 }
 

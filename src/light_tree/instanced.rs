@@ -124,7 +124,7 @@ pub(crate) struct Placed {
 /// ```
 /// use guiding::glam::{Affine3A, Vec3};
 /// use guiding::{Aabb, BuildHeuristic, Emitter, Glt, GltConfig, Instance, InstancedLightTree};
-/// use guiding::{LightHierarchy, LightSampler, LightTree, ShadingContext};
+/// use guiding::{LightChoice, LightHierarchy, LightTree, ShadingContext};
 /// // A lamp shade of two triangles, built once in its own space.
 /// let shade = [
 ///     Emitter::triangle([Vec3::ZERO, Vec3::X, Vec3::Y], 1.0, false),
@@ -146,8 +146,8 @@ pub(crate) struct Placed {
 /// let glt = Glt::new(&tree, street, GltConfig::default()).unwrap();
 /// let ctx = ShadingContext::on_surface(Vec3::new(20.5, 0.5, 3.0), -Vec3::Z);
 /// let vertex = glt.vertex(&ctx).unwrap();
-/// let s = vertex.sample(&ctx, 0.3).unwrap();
-/// assert_eq!(s.pmf, vertex.pmf(&ctx, s.light));
+/// let s = vertex.sample(0.3).unwrap();
+/// assert_eq!(s.pmf, vertex.pmf(s.light));
 /// # Ok::<(), guiding::BuildError>(())
 /// ```
 #[derive(Clone, Debug)]

@@ -14,8 +14,8 @@ use alloc::vec::Vec;
 /// cell that splits gives both children its tree).
 ///
 /// ```
-/// use guiding::math::Accumulation;
-/// use guiding::quadtree::{DirectionalFilter, DirectionalTree, QuadtreeConfig, UNIFORM_PDF};
+/// use guiding::learned::{DirectionalTree, UNIFORM_PDF};
+/// use guiding::{Accumulation, DirectionalFilter, QuadtreeConfig};
 /// use glam::Vec3;
 ///
 /// let mut tree = DirectionalTree::new(Accumulation::Fast);

@@ -67,7 +67,7 @@
 //! an image the estimate is nearly independent of any one pixel.
 //!
 //! ```
-//! use guiding::schedule::{InverseVarianceCombiner, Iterations, PassStats};
+//! use guiding::{InverseVarianceCombiner, Iterations, PassStats};
 //!
 //! let plan: Vec<u64> = Iterations::new(100).map(|it| it.passes).collect();
 //! assert_eq!(plan, [1, 2, 4, 8, 16, 69]);

@@ -83,9 +83,7 @@
 //! reproducible), with steps concentrated where samples are.
 //!
 //! ```
-//! use guiding::math::Aabb;
-//! use guiding::sd_tree::{SdTree, SdTreeConfig};
-//! use guiding::{RecordOutcome, ShadingContext};
+//! use guiding::{Aabb, RecordOutcome, SdTree, SdTreeConfig, ShadingContext};
 //! use glam::Vec3;
 //!
 //! let scene = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));

@@ -99,6 +99,15 @@ impl<'a> DirectionVertex<'a> {
         self.cell.sample(u)
     }
 
+    /// [`DirectionVertex::sample_direction`] with the two numbers drawn
+    /// from a renderer's generator: two `next_u32`, each one's top 24 bits
+    /// times `2^-24`, so the direction equals `sample_direction` of them.
+    #[inline]
+    pub fn sample_direction_with<R: rand_core::Rng + ?Sized>(&self, rng: &mut R) -> (Vec3, f32) {
+        let u0 = crate::math::unit_f32(rng);
+        self.sample_direction([u0, crate::math::unit_f32(rng)])
+    }
+
     /// The solid-angle pdf of `dir` (any positive length) under the cell's
     /// guiding distribution; 0 for an invalid direction.
     #[inline]

@@ -13,8 +13,9 @@
 //! the layout word by word, and `gpu/` holds a WGSL kernel that samples
 //! it, checked against this module on a real GPU API.
 //!
-//! The sampling rule over the arrays is [`SnapshotView::sample`] and its
-//! pmf [`SnapshotView::pmf`]: `no_std`, no allocation, every number in
+//! The sampling rule over the arrays is [`SnapshotView::vertex`], a
+//! [`SnapshotVertex`] with the same [`LightChoice`](crate::LightChoice)
+//! as the CPU guide's vertex: `no_std`, no allocation, every number in
 //! `f32` as a GPU computes it, operation for operation what the WGSL
 //! kernel does. Against the guide's own sampler (which keeps its
 //! descent and products in `f64`) it chooses the same light for the same
@@ -32,7 +33,8 @@
 //!
 //! ```
 //! use guiding::glam::Vec3;
-//! use guiding::{Aabb, BuildHeuristic, Emitter, Glt, GltConfig, LightId, LightTree};
+//! use guiding::{Aabb, BuildHeuristic, Emitter, Glt, GltConfig, LightChoice, LightId, LightTree};
+//! use guiding::ShadingContext;
 //!
 //! let lights = [
 //!     Emitter::point(Vec3::new(-1.0, 2.0, 0.0), 1.0),
@@ -50,10 +52,11 @@
 //!
 //! // The same rule on the CPU.
 //! let view = snapshot.view();
-//! let p = Vec3::new(0.5, 0.0, 0.0);
-//! let s = view.sample(p, Some(Vec3::Y), 0.7).expect("a light");
-//! assert_eq!(s.pmf, view.pmf(p, Some(Vec3::Y), s.light));
-//! let total: f32 = (0..2).map(|e| view.pmf(p, Some(Vec3::Y), LightId::Emitter(e))).sum();
+//! let ctx = ShadingContext::on_surface(Vec3::new(0.5, 0.0, 0.0), Vec3::Y);
+//! let v = view.vertex(&ctx).expect("a finite point");
+//! let s = v.sample(0.7).expect("a light");
+//! assert_eq!(s.pmf, v.pmf(s.light));
+//! let total: f32 = (0..2).map(|e| v.pmf(LightId::Emitter(e))).sum();
 //! assert!((total - 1.0).abs() < 1e-6);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -67,7 +70,7 @@ mod view;
 
 pub use error::SnapshotError;
 pub use layout::{Bounds, BoundsPair, Cell, Header, TreeEntry, TreePair};
-pub use sampling::SnapshotSample;
+pub use sampling::SnapshotVertex;
 pub use view::{SnapshotArrays, SnapshotView};
 
 use crate::cut::CutNode;

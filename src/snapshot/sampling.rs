@@ -10,25 +10,12 @@ use super::layout::{
 };
 use super::view::SnapshotView;
 use crate::cut::{CutNode, Slot};
-use crate::light_sampler::LightId;
+use crate::light_sampler::{LightChoice, LightId, LightSample, ShadingContext};
 use crate::math::Side;
 use glam::Vec3;
 
 /// The largest `f32` below one: where rescaled numbers are clamped.
 const ONE_MINUS_EPS: f32 = 1.0 - f32::EPSILON / 2.0;
-
-/// A light chosen from a snapshot.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SnapshotSample {
-    /// The light.
-    pub light: LightId,
-    /// Its probability, equal to [`SnapshotView::pmf`] bit for bit.
-    pub pmf: f32,
-    /// The learned visibility of the cluster it was chosen from (1 when the
-    /// guide learns none): the resampling target's factor, as
-    /// [`CutRules::sample_with_visibility`](crate::cut::CutRules::sample_with_visibility).
-    pub visibility: f32,
-}
 
 /// `left` and `right` normalised; `None` unless they are non-negative with
 /// a positive finite sum.
@@ -105,6 +92,7 @@ struct Step {
 }
 
 /// One query's fixed parts.
+#[derive(Clone, Copy)]
 struct Rule<'v, 'a> {
     view: &'v SnapshotView<'a>,
     q: Point,
@@ -243,7 +231,7 @@ impl<'v, 'a> Rule<'v, 'a> {
             .unwrap_or(1.0)
     }
 
-    fn sample(&self, u: f32) -> Option<SnapshotSample> {
+    fn sample(&self, u: f32) -> Option<(LightSample, f32)> {
         let c = self.cell;
         let mut d = Descent::new(u);
         if c.unbounded > 0.0 {
@@ -298,6 +286,52 @@ impl<'v, 'a> Rule<'v, 'a> {
         )
     }
 
+    /// The learned visibility of the cluster `light` leaves the cut by
+    /// (1 without any, or for a light out of range): the slot
+    /// [`Rule::sample`] reads when it chooses `light`.
+    fn visibility_of(&self, light: LightId) -> f32 {
+        let a = &self.view.a;
+        let e = match light {
+            LightId::Unbounded(i) if i < a.header.unbounded => {
+                return self.visibility((2 * self.cell.nodes as usize).max(1) + i as usize);
+            }
+            LightId::Unbounded(_) => return 1.0,
+            LightId::Emitter(e) => e,
+        };
+        let (Some(&position), Some((mut at, mut cut))) =
+            (a.leaf_position.get(e as usize), self.root())
+        else {
+            return 1.0;
+        };
+        let mut slot = 0usize;
+        while let Some(i) = cut {
+            if at.link & LEAF != 0 {
+                break;
+            }
+            let (Some(&first), Some(node), Some(pair)) = (
+                a.first_right.get(at.link as usize),
+                self.cut_node(i),
+                a.tree.get(at.link as usize),
+            ) else {
+                return 1.0;
+            };
+            let side = if position >= first {
+                Side::Right
+            } else {
+                Side::Left
+            };
+            cut = match node.slot(side) {
+                Slot::Child(j) => Some(j),
+                Slot::End(_) => None,
+            };
+            if cut.is_none() {
+                slot = 2 * i as usize + side.index();
+            }
+            at = pair.nodes[side.index()];
+        }
+        self.visibility(slot)
+    }
+
     fn pmf(&self, light: LightId) -> f32 {
         let e = match light {
             LightId::Unbounded(i) => return positive(self.unbounded_pmf(i)),
@@ -350,16 +384,12 @@ fn positive(pmf: f32) -> f32 {
     }
 }
 
-/// The sample, or `None` when its pmf is not positive (so sample and pmf
-/// agree).
+/// The sample and its cluster's learned visibility, or `None` when its
+/// pmf is not positive (so sample and pmf agree).
 #[inline(always)]
-fn finish(light: LightId, pmf: f32, visibility: f32) -> Option<SnapshotSample> {
+fn finish(light: LightId, pmf: f32, visibility: f32) -> Option<(LightSample, f32)> {
     let pmf = positive(pmf);
-    (pmf > 0.0).then_some(SnapshotSample {
-        light,
-        pmf,
-        visibility,
-    })
+    (pmf > 0.0).then_some((LightSample { light, pmf }, visibility))
 }
 
 /// The cell of `p` (clamped into the root cube): the spatial tree's walk,
@@ -390,18 +420,69 @@ fn locate(view: &SnapshotView, p: Vec3) -> Option<u32> {
     }
 }
 
-impl SnapshotView<'_> {
-    /// Chooses a light for a point at `position` (with `normal`, or
-    /// `None`) from one uniform number `u` in `[0, 1)`, by the GLT's
-    /// sampling rule (`src/cut/sampling.rs`) in `f32`; `None` when nothing
-    /// can be chosen (a non-finite position, no light with power).
-    pub fn sample(&self, position: Vec3, normal: Option<Vec3>, u: f32) -> Option<SnapshotSample> {
-        Rule::new(self, position, normal)?.sample(u)
+/// A shading point's light choice over a snapshot
+/// ([`SnapshotView::vertex`]): the GLT's sampling rule
+/// (`src/cut/sampling.rs`) in `f32` over the arrays, the point's cell
+/// located once. The same [`LightChoice`] as the CPU guide's
+/// [`LightVertex`](crate::LightVertex): `sample(u)` returns a
+/// [`LightSample`] whose pmf equals `pmf` of its light bit for bit, and
+/// `sample_with_visibility` the learned visibility of the cluster it came
+/// from (what the WGSL kernel returns beside it).
+#[derive(Clone, Copy)]
+pub struct SnapshotVertex<'v, 'a> {
+    rule: Rule<'v, 'a>,
+}
+
+impl core::fmt::Debug for SnapshotVertex<'_, '_> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("SnapshotVertex")
+            .field("cell", &self.rule.cell_index)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<'a> SnapshotView<'a> {
+    /// The light choice at `ctx` (its position and normal; the snapshot
+    /// has no light linking): the cell holding the position (clamped onto
+    /// the root cube), through which `sample` and `pmf` answer. `None` for
+    /// a non-finite position, and for a context that restricts the lights
+    /// (`ShadingContext::lit_by`, `lit_by_unbounded`) that a snapshot
+    /// cannot honour: its guide had no light sets, so only a point lit by
+    /// none of them ([`ShadingContext::receives`] 0, where nothing is
+    /// chosen) or by fewer of its unbounded lights is restricted.
+    pub fn vertex(&self, ctx: &ShadingContext) -> Option<SnapshotVertex<'_, 'a>> {
+        let k = self.a.header.unbounded;
+        if ctx.receives == 0 || ctx.unbounded_received(k) < k {
+            return None;
+        }
+        Some(SnapshotVertex {
+            rule: Rule::new(self, ctx.position, ctx.normal)?,
+        })
+    }
+}
+
+impl LightChoice for SnapshotVertex<'_, '_> {
+    #[inline]
+    fn sample(&self, u: f32) -> Option<LightSample> {
+        self.rule.sample(u).map(|(s, _)| s)
     }
 
-    /// The probability that [`SnapshotView::sample`] chooses `light` at
-    /// `position` (0 for lights it never chooses and ids out of range).
-    pub fn pmf(&self, position: Vec3, normal: Option<Vec3>, light: LightId) -> f32 {
-        Rule::new(self, position, normal).map_or(0.0, |r| r.pmf(light))
+    #[inline]
+    fn pmf(&self, light: LightId) -> f32 {
+        self.rule.pmf(light)
+    }
+
+    fn is_empty(&self) -> bool {
+        let c = self.rule.cell;
+        !(c.unbounded > 0.0 || c.cut > 0.0 || self.rule.prior)
+    }
+
+    fn visibility(&self, light: LightId) -> f32 {
+        self.rule.visibility_of(light)
+    }
+
+    #[inline]
+    fn sample_with_visibility(&self, u: f32) -> Option<(LightSample, f32)> {
+        self.rule.sample(u)
     }
 }

@@ -75,8 +75,8 @@ impl SnapshotArrays<'_> {
 }
 
 /// Snapshot arrays known to be valid: every walk over them stays in
-/// bounds and ends (links only point forward). [`SnapshotView::sample`]
-/// and [`SnapshotView::pmf`] are the GLT's sampling rule over them
+/// bounds and ends (links only point forward). [`SnapshotView::vertex`]
+/// gives the GLT's sampling rule over them
 /// (`src/snapshot/sampling.rs`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SnapshotView<'a> {

@@ -22,8 +22,8 @@
 //! cannot be represented), so trees hundreds of levels deep work.
 //!
 //! ```
-//! use guiding::math::Aabb;
-//! use guiding::spatial::{BinaryTree, SpatialTree};
+//! use guiding::Aabb;
+//! use guiding::learned::{BinaryTree, SpatialTree};
 //! use glam::Vec3;
 //!
 //! // Cells count the points that fall in them; split any cell above 2.

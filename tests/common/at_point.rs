@@ -8,7 +8,8 @@ use guiding::glt::Glt;
 use guiding::light_tree::LightHierarchy;
 use guiding::sd_tree::SdTree;
 use guiding::{
-    DirectionVertex, LightId, LightSample, LightSampler, LightVertex, RecordOutcome, ShadingContext,
+    DirectionVertex, LightChoice, LightId, LightSample, LightSampler, LightVertex, RecordOutcome,
+    ShadingContext,
 };
 
 /// A GLT's or field's light vertex at a point, and the records made there
@@ -17,8 +18,12 @@ use guiding::{
 pub trait LightsAt {
     /// The light hierarchy.
     type Lights: LightHierarchy;
-    /// The light vertex at `p`.
-    fn light_vertex(&self, p: Vec3) -> Option<LightVertex<'_, Self::Lights>>;
+    /// The light vertex for `ctx`.
+    fn light_vertex_for(&self, ctx: &ShadingContext) -> Option<LightVertex<'_, Self::Lights>>;
+    /// The light vertex at `p` (no normal, every light).
+    fn light_vertex(&self, p: Vec3) -> Option<LightVertex<'_, Self::Lights>> {
+        self.light_vertex_for(&at(p))
+    }
     /// The light vertex at `p` (panics where there is none).
     fn light_at(&self, p: Vec3) -> LightVertex<'_, Self::Lights> {
         self.light_vertex(p).expect("a finite point")
@@ -99,15 +104,15 @@ fn at(p: Vec3) -> ShadingContext {
 
 impl<H: LightHierarchy> LightsAt for Glt<H> {
     type Lights = H;
-    fn light_vertex(&self, p: Vec3) -> Option<LightVertex<'_, H>> {
-        self.vertex(&at(p))
+    fn light_vertex_for(&self, ctx: &ShadingContext) -> Option<LightVertex<'_, H>> {
+        self.vertex(ctx)
     }
 }
 
 impl<H: LightHierarchy> LightsAt for GuidingField<H> {
     type Lights = H;
-    fn light_vertex(&self, p: Vec3) -> Option<LightVertex<'_, H>> {
-        self.vertex(&at(p)).map(|v| v.light)
+    fn light_vertex_for(&self, ctx: &ShadingContext) -> Option<LightVertex<'_, H>> {
+        self.vertex(ctx).map(|v| v.light)
     }
 }
 
@@ -124,14 +129,14 @@ impl DirectionsAt for SdTree {
 }
 
 /// A GLT or field as a [`LightSampler`] by position: every call locates
-/// the vertex at `ctx.position` and answers through it (what the guides
-/// themselves did before every query went through a vertex).
+/// the vertex for `ctx` and answers through it (what
+/// [`guiding::Strategy`] does for its GLT).
 #[derive(Clone, Copy, Debug)]
 pub struct ByPosition<'a, G>(pub &'a G);
 
 macro_rules! by_position {
     ($g:ident, $ctx:ident, $v:ident => $call:expr, $none:expr) => {
-        match $g.0.light_vertex($ctx.position) {
+        match $g.0.light_vertex_for(&$ctx) {
             Some($v) => $call,
             None => $none,
         }
@@ -140,25 +145,28 @@ macro_rules! by_position {
 
 impl<G: LightsAt> LightSampler for ByPosition<'_, G> {
     fn sample(&self, ctx: &ShadingContext, u: f32) -> Option<LightSample> {
-        by_position!(self, ctx, v => v.sample(ctx, u), None)
+        by_position!(self, ctx, v => v.sample(u), None)
     }
     fn pmf(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        by_position!(self, ctx, v => v.pmf(ctx, light), 0.0)
+        by_position!(self, ctx, v => v.pmf(light), 0.0)
     }
     fn is_empty(&self) -> bool {
         let ctx = at(Vec3::ZERO);
         by_position!(self, ctx, v => v.is_empty(), true)
     }
+    fn is_empty_at(&self, ctx: &ShadingContext) -> bool {
+        by_position!(self, ctx, v => v.is_empty(), true)
+    }
     fn sample_exact(&self, ctx: &ShadingContext, u: f64) -> Option<(LightId, f64)> {
-        by_position!(self, ctx, v => v.sample_exact(ctx, u), None)
+        by_position!(self, ctx, v => v.sample_exact(u), None)
     }
     fn pmf_exact(&self, ctx: &ShadingContext, light: LightId) -> f64 {
-        by_position!(self, ctx, v => v.pmf_exact(ctx, light), 0.0)
+        by_position!(self, ctx, v => v.pmf_exact(light), 0.0)
     }
     fn visibility(&self, ctx: &ShadingContext, light: LightId) -> f32 {
-        by_position!(self, ctx, v => v.visibility(ctx, light), 1.0)
+        by_position!(self, ctx, v => v.visibility(light), 1.0)
     }
     fn sample_with_visibility(&self, ctx: &ShadingContext, u: f32) -> Option<(LightSample, f32)> {
-        by_position!(self, ctx, v => v.sample_with_visibility(ctx, u), None)
+        by_position!(self, ctx, v => v.sample_with_visibility(u), None)
     }
 }

@@ -9,7 +9,7 @@
 
 use glam::Vec3;
 use guiding::math::{Aabb, LightCone};
-use guiding::{Emitter, LightSampler};
+use guiding::{Emitter, LightChoice};
 use rand_pcg::Pcg64Mcg;
 use rand_pcg::rand_core::{Rng, SeedableRng};
 
@@ -276,13 +276,12 @@ pub fn gamma_q(a: f64, x: f64) -> f64 {
 /// is a p-value below 1e-4.
 pub const Z_P_1E4: f64 = 3.719_016_5;
 
-/// Draws `draws` emitters from `s` at `ctx` (each draw reporting exactly
-/// its `pmf`), counts them over emitters `0..n`, and returns the counts
-/// and the chi-square z against `pmf_exact` (below 4 for a sampler that
-/// draws what it says).
-pub fn emitter_draws<S: guiding::LightSampler + ?Sized>(
+/// Draws `draws` emitters from the light choice `s` (each draw reporting
+/// exactly its `pmf`), counts them over emitters `0..n`, and returns the
+/// counts and the chi-square z against `pmf_exact` (below 4 for a sampler
+/// that draws what it says).
+pub fn emitter_draws<S: guiding::LightChoice + ?Sized>(
     s: &S,
-    ctx: &guiding::ShadingContext,
     n: usize,
     draws: usize,
     r: &mut Rand,
@@ -290,15 +289,15 @@ pub fn emitter_draws<S: guiding::LightSampler + ?Sized>(
     use guiding::LightId;
     let mut counts = vec![0u64; n];
     for _ in 0..draws {
-        let x = s.sample(ctx, r.f()).expect("a light");
+        let x = s.sample(r.f()).expect("a light");
         let LightId::Emitter(e) = x.light else {
             panic!("{:?}", x.light)
         };
-        assert_eq!(x.pmf.to_bits(), s.pmf(ctx, x.light).to_bits());
+        assert_eq!(x.pmf.to_bits(), s.pmf(x.light).to_bits());
         counts[e as usize] += 1;
     }
     let probs: Vec<f64> = (0..n as u32)
-        .map(|e| s.pmf_exact(ctx, LightId::Emitter(e)))
+        .map(|e| s.pmf_exact(LightId::Emitter(e)))
         .collect();
     let (z, _) = chi_square_z(&counts, &probs).expect("no draw of pmf 0");
     (counts, z)
@@ -364,7 +363,7 @@ pub fn train_on_own_choices<H: guiding::LightHierarchy>(
             let Some(vertex) = glt.vertex(&ctx) else {
                 continue;
             };
-            if let Some(s) = vertex.sample(&ctx, r.f()) {
+            if let Some(s) = vertex.sample(r.f()) {
                 let guiding::LightId::Emitter(e) = s.light else {
                     continue;
                 };

@@ -11,6 +11,7 @@ use crate::geometry::{NO_EMITTER, offset_origin};
 use crate::rng::Sampler;
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
+use guiding::LightChoice;
 use guiding::field::GuidingField;
 use guiding::glt::Glt;
 use guiding::luminance;
@@ -18,7 +19,8 @@ use guiding::mis::Convention;
 use guiding::resampling::{Evaluated, resample};
 use guiding::sd_tree::SdTree;
 use guiding::{
-    DirectionVertex, LightId, LightSampler, LightTree, LightVertex, PathRecorder, ShadingContext,
+    DirectionVertex, LightId, LightSampler, LightTree, LightVertex, PathRecorder, SamplerAt,
+    ShadingContext,
 };
 
 /// What a path consults and trains.
@@ -114,7 +116,7 @@ fn found_light(
     // The light strategy took `v.nee` samples at `v`.
     let ctx = ShadingContext::on_surface(v.pos, v.normal);
     let pmf = match (&v.light, guides.lights) {
-        (Some(l), _) => l.pmf(&ctx, id),
+        (Some(l), _) => l.pmf(id),
         (None, Some(fixed)) => fixed.pmf(&ctx, id),
         (None, None) => 0.0,
     } * v.nee as f32;
@@ -248,9 +250,13 @@ pub fn radiance<'a>(
         };
         // The light vertex samples its cell's cut without a lookup per
         // query.
-        let nee: &dyn LightSampler = match (&light_vertex, guides.lights) {
+        let fixed_here;
+        let nee: &dyn LightChoice = match (&light_vertex, guides.lights) {
             (Some(v), _) => v,
-            (None, Some(fixed)) => fixed,
+            (None, Some(fixed)) => {
+                fixed_here = SamplerAt::new(fixed, &ctx);
+                &fixed_here
+            }
             (None, None) => break,
         };
 
@@ -306,7 +312,7 @@ pub fn radiance<'a>(
                         Evaluated::new(c, (lp, false)).with_densities(lp.pdf, pdf),
                     ))
                 });
-                resample(nee, &ctx, &cands[..m], u_keep, found, |light, _| {
+                resample(nee, &cands[..m], u_keep, found, |light, _| {
                     let (lp, delta) = point_on(light, s.next2());
                     let lp = lp?;
                     let (f, bsdf_pdf) = mat.eval(n, wo, lp.wi);
@@ -323,7 +329,7 @@ pub fn radiance<'a>(
                 })
                 .map(|r| (r.light, r.pmf, Some((r.weight, r.bsdf)), Some(r.payload)))
             } else {
-                nee.sample(&ctx, s.next())
+                nee.sample(s.next())
                     .map(|ls| (ls.light, ls.pmf * draws as f32, None, None))
             };
             let Some((light, pmf, resampled, point)) = chosen else {

@@ -6,7 +6,7 @@
 
 use guiding::glam::Vec3;
 use guiding::snapshot::Snapshot;
-use guiding::{Glt, LightTree, ShadingContext};
+use guiding::{Glt, LightChoice, LightTree, ShadingContext};
 use guiding_gpu::{Answer, Query};
 use guiding_render::methods::{GuideParams, Method};
 use guiding_render::scene::Scene;
@@ -92,12 +92,18 @@ pub fn cpu_answers(snapshot: &Snapshot, queries: &[Query]) -> Vec<Answer> {
         .iter()
         .map(|q| {
             let n = Vec3::from_array(q.n);
-            let normal = (n != Vec3::ZERO).then_some(n);
-            match view.sample(Vec3::from_array(q.p), normal, q.u) {
-                Some(s) => Answer {
+            let ctx = ShadingContext {
+                normal: (n != Vec3::ZERO).then_some(n),
+                ..ShadingContext::at(Vec3::from_array(q.p))
+            };
+            match view
+                .vertex(&ctx)
+                .and_then(|v| v.sample_with_visibility(q.u))
+            {
+                Some((s, visibility)) => Answer {
                     light: Query::light_word(s.light),
                     pmf: s.pmf,
-                    visibility: s.visibility,
+                    visibility,
                     pad: 0,
                 },
                 None => Answer {
@@ -124,7 +130,7 @@ pub fn glt_answers(glt: &Glt<&LightTree>, queries: &[Query]) -> Vec<Answer> {
         .map(|q| {
             let ctx = context(q);
             let v = glt.vertex(&ctx).expect("a cell");
-            match glt.cut_rules().sample_with_visibility(v.cut(), &ctx, q.u) {
+            match v.sample_with_visibility(q.u) {
                 Some((s, visibility)) => Answer {
                     light: Query::light_word(s.light),
                     pmf: s.pmf,

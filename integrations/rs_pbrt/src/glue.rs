@@ -3,7 +3,7 @@
 
 use crate::path_tracer::{LightAt, LightStrategy};
 use guiding::glam::Vec3;
-use guiding::{Aabb, Emitter, Glt, GltConfig, LightId, LightSampler, LightTree};
+use guiding::{Aabb, Emitter, Glt, GltConfig, LightChoice, LightId, LightTree};
 use guiding::{LightVertex, ShadingContext, UnboundedLights, luminance};
 use rs_pbrt::core::{geometry::Point2f, interaction::SurfaceInteraction, light::Light};
 use rs_pbrt::core::{scene::Scene, shape::Shape};
@@ -69,15 +69,16 @@ impl GltStrategy {
     }
 }
 
-/// The GLT's view from one shading point: its vertex (one lookup).
-pub struct GltAt<'a>(Option<(LightVertex<'a, LightTree>, ShadingContext)>, u32);
+/// The GLT's view from one shading point: its vertex (one lookup; it
+/// keeps the context).
+pub struct GltAt<'a>(Option<LightVertex<'a, LightTree>>, u32);
 
 impl LightStrategy for GltStrategy {
     type At<'a> = GltAt<'a>;
 
     fn at<'a>(&'a self, it: &SurfaceInteraction) -> GltAt<'a> {
         let ctx = ShadingContext::facing(v!(it.common.p), v!(it.shading.n), v!(it.common.wo));
-        GltAt(self.0.vertex(&ctx).map(|v| (v, ctx)), self.1)
+        GltAt(self.0.vertex(&ctx), self.1)
     }
 
     fn refine(&mut self) {
@@ -87,13 +88,12 @@ impl LightStrategy for GltStrategy {
 
 impl LightAt for GltAt<'_> {
     fn choose(&self, u: f32) -> Option<(usize, f32)> {
-        let (v, ctx) = self.0.as_ref()?;
-        let s = v.sample(ctx, u)?;
+        let s = self.0.as_ref()?.sample(u)?;
         Some((s.light.index(self.1) as usize, s.pmf))
     }
 
     fn record(&self, light: usize, value: f32) {
-        if let Some((v, _)) = &self.0 {
+        if let Some(v) = &self.0 {
             v.record_light(LightId::from_index(light as u32, self.1), value);
         }
     }

@@ -38,7 +38,7 @@ use guiding_render::{geometry, methods, rng, run, scene, scenes, shading_points}
 use brute_force::PointTerms;
 use clap::Parser;
 use glt_variant::GltVariant;
-use guiding::{LightId, LightSampler, ShadingContext};
+use guiding::{LightChoice, LightId, LightSampler, ShadingContext};
 use methods::Method;
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -346,7 +346,7 @@ fn measure_scene(args: &Args, name: &str, variants: &[GltVariant]) -> Result<Vec
                     .lights
                     .iter()
                     .map(|l| {
-                        let v = glt.vertex(ctx).map_or(1.0, |v| v.visibility(ctx, l.light));
+                        let v = glt.vertex(ctx).map_or(1.0, |v| v.visibility(l.light));
                         f64::from(v).powf(e)
                     })
                     .collect(),
@@ -558,5 +558,5 @@ fn pmf_at(
     ctx: &ShadingContext,
     light: LightId,
 ) -> f32 {
-    glt.vertex(ctx).map_or(0.0, |v| v.pmf(ctx, light))
+    glt.vertex(ctx).map_or(0.0, |v| v.pmf(light))
 }
