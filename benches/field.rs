@@ -1,11 +1,11 @@
 //! The combined guiding field per path vertex: the one lookup
 //! (`vertex`), then a guided direction and a light from the same cell,
 //! beside the same work on a separate SD-tree and GLT (two lookups), and the
-//! two splats a vertex makes. Prints the memory report (cuts beside
+//! two records a vertex makes. Prints the memory report (cuts beside
 //! quadtrees).
 //!
 //! 10,000 lights in a 200^3 box; the field is trained for four iterations
-//! (50k, 100k, 200k, 400k vertices) with synthetic splats: a fragmented
+//! (50k, 100k, 200k, 400k vertices) with synthetic records: a fragmented
 //! quarter of the lights is visible, with inverse-square falloff, and
 //! radiance arrives from the visible lights. The separate SD-tree and GLT
 //! are trained on the same stream. Short run: `cargo bench --bench field --
@@ -189,7 +189,7 @@ fn bench_field(c: &mut Criterion) {
     });
     // The whole vertex: queries and both records (both through the
     // stochastic box, as configured).
-    group.bench_function("vertex+direction+light+splats", |b| {
+    group.bench_function("vertex+direction+light+records", |b| {
         b.iter(|| {
             let (ctx, u) = black_box(&queries[next()]);
             let v = field.vertex(ctx).unwrap();

@@ -2,10 +2,10 @@
 //! call for sigma in {0.05, 0.01, 0.002} and 1e2..1e6 lights, beside
 //! tree-by-power sampling on the same tree; a whole GLT's `sample` and
 //! `sample` + `pmf` beside its GPU snapshot's `f32` sampler on the CPU;
-//! `splat` per call; `refine` per cell; bytes per cut node and per cell
+//! `record` per call; `refine` per cell; bytes per cut node and per cell
 //! (printed).
 //!
-//! Cuts are trained with synthetic splats (a fragmented visible subset with
+//! Cuts are trained with synthetic records (a fragmented visible subset with
 //! distance falloff, sampled from the cut itself as a renderer would) so they
 //! reach realistic sizes. Short run: `cargo bench --bench glt --
 //! --warm-up-time 0.3 --measurement-time 1 --sample-size 20`; set
@@ -89,7 +89,7 @@ fn trained_cut(lights: &[Emitter], guide: &CutRules<&LightTree>) -> GuidingCut {
             let LightId::Emitter(e) = s.light else {
                 continue;
             };
-            guide.splat_from(&cut, POINT, s.light, contribution(lights, e, POINT) / s.pmf);
+            guide.record_from(&cut, POINT, s.light, contribution(lights, e, POINT) / s.pmf);
         }
         guide.refine(&mut cut);
     }
@@ -320,7 +320,7 @@ fn bench_sampling(c: &mut Criterion) {
                     power.pmf(&ctx, s.light)
                 })
             });
-            group.bench_function("glt/splat", |b| {
+            group.bench_function("glt/record", |b| {
                 b.iter(|| {
                     let i = next();
                     glt.record_light_at(
@@ -333,10 +333,10 @@ fn bench_sampling(c: &mut Criterion) {
             let config = CutConfig::default();
             let guide = CutRules::new(&tree, config).unwrap();
             let cut = trained_cut(&lights, &guide);
-            group.bench_function("cut/splat", |b| {
+            group.bench_function("cut/record", |b| {
                 b.iter(|| {
                     let i = next();
-                    guide.splat(&cut, black_box(LightId::Emitter(i as u32 % n as u32)), 1.5)
+                    guide.record(&cut, black_box(LightId::Emitter(i as u32 % n as u32)), 1.5)
                 })
             });
         }
@@ -357,7 +357,7 @@ fn bench_sampling(c: &mut Criterion) {
                     let LightId::Emitter(e) = s.light else {
                         continue;
                     };
-                    guide.splat(&cut, s.light, contribution(&lights, e, POINT) / s.pmf);
+                    guide.record(&cut, s.light, contribution(&lights, e, POINT) / s.pmf);
                 }
             }
             group.bench_function(BenchmarkId::new("cut/refine", sigma), |b| {

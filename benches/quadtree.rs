@@ -1,5 +1,5 @@
 //! The directional quadtree per call against depth: `sample`, `pdf`,
-//! `splat` (both filters, both accumulation modes) and `refine` per tree,
+//! `record` (both filters, both accumulation modes) and `refine` per tree,
 //! plus bytes per node (printed before the timings).
 //!
 //! `cargo bench --bench quadtree`; medians are in
@@ -43,7 +43,7 @@ fn draw(r: &mut Pcg64) -> (Vec3, f32) {
 }
 
 /// A tree refined until its sampling copy is `depth` levels deep, holding
-/// one iteration of splats in its building copy.
+/// one iteration of records in its building copy.
 fn trained(depth: u32, mode: Accumulation) -> (DirectionalTree, QuadtreeConfig) {
     let config = QuadtreeConfig {
         rho: 0.01,
@@ -51,20 +51,20 @@ fn trained(depth: u32, mode: Accumulation) -> (DirectionalTree, QuadtreeConfig) 
     };
     let mut r = Pcg64::seed_from_u64(depth as u64);
     let mut tree = DirectionalTree::new(mode);
-    let splat = |tree: &DirectionalTree, r: &mut Pcg64| {
+    let record = |tree: &DirectionalTree, r: &mut Pcg64| {
         for _ in 0..50_000 {
             let (d, v) = draw(r);
-            tree.splat(d, v, DirectionalFilter::Nearest);
+            tree.record(d, v, DirectionalFilter::Nearest);
         }
     };
     for _ in 0..16 {
-        splat(&tree, &mut r);
+        record(&tree, &mut r);
         tree.refine(&config);
         if tree.depth() as u32 >= depth && tree.building_depth() as u32 >= depth {
             break;
         }
     }
-    splat(&tree, &mut r);
+    record(&tree, &mut r);
     (tree, config)
 }
 
@@ -117,25 +117,25 @@ fn queries(c: &mut Criterion) {
     }
 }
 
-fn splats(c: &mut Criterion) {
+fn records(c: &mut Criterion) {
     let cases = [
         (
-            "quadtree_splat_nearest",
+            "quadtree_record_nearest",
             Accumulation::Fast,
             DirectionalFilter::Nearest,
         ),
         (
-            "quadtree_splat_box",
+            "quadtree_record_box",
             Accumulation::Fast,
             DirectionalFilter::Box,
         ),
         (
-            "quadtree_splat_nearest_deterministic",
+            "quadtree_record_nearest_deterministic",
             Accumulation::Deterministic,
             DirectionalFilter::Nearest,
         ),
         (
-            "quadtree_splat_box_deterministic",
+            "quadtree_record_box_deterministic",
             Accumulation::Deterministic,
             DirectionalFilter::Box,
         ),
@@ -151,7 +151,7 @@ fn splats(c: &mut Criterion) {
                 b.iter(|| {
                     i = (i + 1) % BATCH;
                     let (d, v) = input[i];
-                    tree.splat(black_box(d), black_box(v), filter)
+                    tree.record(black_box(d), black_box(v), filter)
                 })
             });
         }
@@ -183,5 +183,5 @@ fn refine(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, report_memory, queries, splats, refine);
+criterion_group!(benches, report_memory, queries, records, refine);
 criterion_main!(benches);

@@ -1,5 +1,5 @@
 //! SD-tree costs per call on a trained tree: the spatial lookup alone,
-//! `sample`, `pdf`, `splat` (per filter and accumulation mode), and `refine`
+//! `sample`, `pdf`, `record` (per filter and accumulation mode), and `refine`
 //! per cell. Prints the memory report and bytes per node.
 
 #[path = "../tests/common/mod.rs"]
@@ -41,7 +41,7 @@ fn lobe_dir(rng: &mut Pcg32) -> Vec3 {
     (l + 0.03 * n).normalize()
 }
 
-/// Five iterations of 2^k * 20000 lobe splats with threshold c.
+/// Five iterations of 2^k * 20000 lobe records with threshold c.
 fn trained(config: SdTreeConfig) -> SdTree {
     let mut t = SdTree::new(scene(), config).unwrap();
     let mut rng = Pcg32::seed_from_u64(1);
@@ -120,16 +120,16 @@ fn queries(c: &mut Criterion) {
     });
     let filters = [
         (
-            "splat/nearest",
+            "record/nearest",
             SpatialFilter::Nearest,
             DirectionalFilter::Nearest,
         ),
         (
-            "splat/stochastic_box+box",
+            "record/stochastic_box+box",
             SpatialFilter::StochasticBox,
             DirectionalFilter::Box,
         ),
-        ("splat/box+box", SpatialFilter::Box, DirectionalFilter::Box),
+        ("record/box+box", SpatialFilter::Box, DirectionalFilter::Box),
     ];
     for (name, spatial_filter, directional_filter) in filters {
         let filtered = trained(SdTreeConfig {
@@ -149,7 +149,7 @@ fn queries(c: &mut Criterion) {
         ..config
     });
     report("deterministic", &det);
-    g.bench_function("splat/nearest/deterministic", |b| {
+    g.bench_function("record/nearest/deterministic", |b| {
         b.iter(|| {
             i = (i + 1) % QUERIES;
             black_box(det.record_radiance_at(points[i], dirs[i], 1.0, 0.5))
@@ -159,7 +159,7 @@ fn queries(c: &mut Criterion) {
 }
 
 fn refine(c: &mut Criterion) {
-    // A tree holding one more iteration of splats, refined from a clone.
+    // A tree holding one more iteration of records, refined from a clone.
     let config = SdTreeConfig {
         spatial_threshold: 4000.0,
         learn_bsdf_fraction: true,

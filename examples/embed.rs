@@ -2,7 +2,7 @@
 //! light tree from the scene's lights, choose lights for next-event
 //! estimation (NEE) with the Guiding Light Tree, weigh NEE against BSDF
 //! sampling by multiple importance sampling (MIS) with `sample` + `pmf`,
-//! splat what each sample found, and refine between iterations.
+//! record what each sample found, and refine between iterations.
 //!
 //! The "renderer" here is tiny and exact: 32 sphere lights above a floor,
 //! split by an infinite wall at x = 0, so each half of the floor sees only
@@ -243,7 +243,7 @@ pub fn run() -> bool {
         "uniform NEE: relative RMSE {:.4}",
         error(&lights, by_uniform, &points, 16, &mut rng)
     );
-    // 4. Iterations: sample + splat with `&self` (any number of threads
+    // 4. Iterations: sample + record with `&self` (any number of threads
     //    could), then refine with `&mut self`.
     for iteration in 0..6 {
         let passes = 1u32 << iteration;

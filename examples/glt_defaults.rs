@@ -7,7 +7,7 @@
 //! cargo run --release --example glt_defaults
 //! ```
 //!
-//! optionally with `GLT_TRAIN=200000` (splats per iteration) and
+//! optionally with `GLT_TRAIN=200000` (records per iteration) and
 //! `GLT_SEED=2`. Scene: 2000 emitters (a third point lights, the rest small
 //! one-sided quads with random normals) above a floor divided into 8x8-unit
 //! rooms; a light is visible from the floor in its own room, and from the

@@ -1,6 +1,6 @@
 //! What each fuzz target checks, shared with the corpus regression test
 //! (`tests/fuzz_corpus.rs`): loading arbitrary bytes, building a light
-//! tree from arbitrary emitters, arbitrary splat / refine / sample
+//! tree from arbitrary emitters, arbitrary record / refine / sample
 //! sequences. Each either gets a typed error or keeps every contract;
 //! none may panic.
 

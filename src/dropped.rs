@@ -108,7 +108,7 @@ impl DropCounters {
         let s = Self::default();
         for c in &s.counts {
             #[allow(clippy::useless_conversion, clippy::unnecessary_cast)]
-            c.store(r.u64("dropped splats")? as _, Relaxed);
+            c.store(r.u64("dropped records")? as _, Relaxed);
         }
         Ok(s)
     }

@@ -63,7 +63,7 @@
 //! | resampled light choice (candidates, reservoir, weight) | `src/resampling.rs` |
 //! | each cut cluster's learned visibility (the resampling target's factor) | `src/cut/visibility.rs` |
 //! | the light tree laid out for the GLT's walk | `src/cut/walk.rs` |
-//! | cut refinement (split / merge by sigma, `min_splats`) | `src/cut/refine.rs` |
+//! | cut refinement (split / merge by sigma, `min_records`) | `src/cut/refine.rs` |
 //! | the tables every cut reads (`CutRules`) | `src/cut/cut_rules.rs` |
 //! | a path's radiance records | `src/path_recorder.rs` |
 //! | the save format and its checks | `src/persist/`, `docs/format.md` |

@@ -110,7 +110,7 @@ fn glt_spatial_threshold() {
         .map(|_| ())
     };
     assert_eq!(make(1e-3), Ok(()));
-    // 0 split every cell on every splat (99,772 cells from 30k splats).
+    // 0 split every cell on every record (99,772 cells from 30k records).
     for c in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         match make(c) {
             Err(Error::Config(ConfigError { field, .. })) => {

@@ -119,7 +119,7 @@ fn a_choice_learned_elsewhere_fails_the_check() {
             let LightId::Emitter(e) = s.light else {
                 continue;
             };
-            rules.splat_from(&cut, p, s.light, value(&lights, e, p) / s.pmf);
+            rules.record_from(&cut, p, s.light, value(&lights, e, p) / s.pmf);
         }
         rules.refine(&mut cut);
     }

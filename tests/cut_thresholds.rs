@@ -6,7 +6,7 @@
 //!
 //! The scene is four equal point lights in two pairs far apart, so the
 //! light tree is a root over two clusters of two leaves. With the paper's
-//! rules the learned weights are the splatted sums themselves, exact in
+//! rules the learned weights are the recorded sums themselves, exact in
 //! `f64`, so the comparison with `sigma * T` is exercised at equality.
 
 use glam::Vec3;
@@ -42,19 +42,19 @@ fn tree() -> LightTree {
 fn rules(tree: &LightTree, sigma: f64) -> CutRules<&LightTree> {
     let config = CutConfig {
         sigma,
-        min_splats: 0,
+        min_records: 0,
         ..CutConfig::default()
     }
     .with_paper_rules();
     CutRules::new(tree, config).unwrap()
 }
 
-/// A cut refined once from splats of `values[e]` for emitter `e`.
+/// A cut refined once from records of `values[e]` for emitter `e`.
 fn refined(rules: &CutRules<&LightTree>, values: [f32; 4]) -> GuidingCut {
     let mut cut = rules.new_cut();
     for (e, &v) in values.iter().enumerate() {
         if v > 0.0 {
-            rules.splat(&cut, LightId::Emitter(e as u32), v);
+            rules.record(&cut, LightId::Emitter(e as u32), v);
         }
     }
     rules.refine(&mut cut);

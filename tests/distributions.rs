@@ -218,7 +218,7 @@ fn found(p: Vec3, light: LightId) -> f32 {
 }
 
 /// `iterations` of NEE training: at random points, a light drawn from
-/// `sample`, its estimate splatted through `splat`, then `refine`.
+/// `sample`, its estimate recorded through `record`, then `refine`.
 /// Trains `guide` by light samples drawn from it, each recorded through
 /// the vertex that drew it, with `also` recording more at the point.
 fn train<G: LightsAt>(

@@ -95,9 +95,9 @@ fn bounds_bits(b: Aabb) -> [u32; 6] {
     [a[0], a[1], a[2], c[0], c[1], c[2]].map(f32::to_bits)
 }
 
-/// The field against an [`SdTree`] fed the same radiance splats and
+/// The field against an [`SdTree`] fed the same radiance records and
 /// fraction records (with identically seeded generators) and, per cell of
-/// that SD-tree, a cut of its own fed the same light splats through the
+/// that SD-tree, a cut of its own fed the same light records through the
 /// [`CutRules`] (cuts copied to both children when the SD-tree splits a
 /// cell). All records and queries go through one [`FieldVertex`] lookup per
 /// point; the SD-tree and the cuts are asked by position. Everything is
@@ -139,7 +139,7 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
             let val = value(&lights, emitter(s.light), p) / s.pmf;
             assert_eq!(
                 v.light.record_light(s.light, val),
-                guide.splat_from(cut, p, s.light, val)
+                guide.record_from(cut, p, s.light, val)
             );
             // Directions: sample, pdf, fraction, mixture.
             let u = [rng.f(), rng.f()];
@@ -227,8 +227,8 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
 }
 
 /// The field against a [`Glt`] over its own spatial tree. The two split
-/// cells by different counts (the field by radiance-splat weight, halved
-/// exactly; the GLT by its number of light splats, halved as an integer),
+/// cells by different counts (the field by radiance-record weight, halved
+/// exactly; the GLT by its number of light records, halved as an integer),
 /// so their spatial decisions agree when every light record comes with a
 /// radiance record at the same point, both go to the cell holding it (the
 /// nearest filter: a jittered light record may land in a neighbour the
@@ -236,7 +236,7 @@ fn one_lookup_equals_a_separate_sd_tree_and_cuts() {
 /// cascade here halves more than 3 times). Then cells, cuts, pmfs and
 /// samples are equal bit for bit.
 #[test]
-fn equals_a_glt_fed_the_same_light_splats() {
+fn equals_a_glt_fed_the_same_light_records() {
     let (lights, tree) = rooms();
     let cut = CutConfig {
         accumulation: Accumulation::Deterministic,
@@ -350,7 +350,7 @@ fn random_lights(rng: &mut Rand, n: usize, dark: usize) -> Vec<Emitter> {
 proptest! {
     #![proptest_config(ProptestConfig { cases: 16, ..ProptestConfig::default() })]
 
-    /// After random splats and refinements, at random points: every cut is
+    /// After random records and refinements, at random points: every cut is
     /// valid, the pmf sums to 1 (emitters and environment), sampling's pmf
     /// equals `pmf` bit for bit (through the vertex, `f32` and
     /// `f64`), and sampled directions' pdfs equal `direction_pdf`.
@@ -421,7 +421,7 @@ proptest! {
 }
 
 /// A field trained on the two rooms for four iterations (vertex API, the
-/// default stochastic-box light splats).
+/// default stochastic-box light records).
 /// `after_refine` sees the field and each refinement's outcome.
 fn trained_field<'a>(
     tree: &'a LightTree,
@@ -498,7 +498,7 @@ fn direction_pdf_integrates_to_one_in_every_cell() {
 
 /// A spatial split gives both children copies of the quadtree and of the
 /// cut: before new data their directions answer identically, and the cut
-/// is trusted only in the cells its light splats came from. The next round
+/// is trusted only in the cells its light records came from. The next round
 /// changes only the cell that gets data.
 #[test]
 fn spatial_split_copies_both_payloads() {
@@ -550,7 +550,7 @@ fn spatial_split_copies_both_payloads() {
         vf.direction.direction_pdf(dir).to_bits()
     );
     // The same learned cut in both cells, but the far cell got none of the
-    // light splats it learned from: there it samples as the prior does,
+    // light records it learned from: there it samples as the prior does,
     // near p as learned.
     assert_eq!(vn.light.cut().confidence(), 1.0);
     assert_eq!(vf.light.cut().confidence(), 0.0);
@@ -603,11 +603,11 @@ fn spatial_split_copies_both_payloads() {
 
 /// Bad input is dropped, counted per kind and never stored, through the
 /// field and through a vertex; queries at non-finite points answer nothing.
-/// A split shares the cut's trust by where its light splats fell: a half
+/// A split shares the cut's trust by where its light records fell: a half
 /// with 2% of them (below the 5% a half needs for full trust) gets
-/// confidence 0.4, the other 1; each half counts its own octants' splats.
+/// confidence 0.4, the other 1; each half counts its own octants' records.
 #[test]
-fn a_split_shares_trust_by_where_the_light_splats_fell() {
+fn a_split_shares_trust_by_where_the_light_records_fell() {
     let (_, tree) = rooms();
     // 1000 radiance records: above 600, one split; its halves (500) are
     // below the next level's threshold.
@@ -616,18 +616,18 @@ fn a_split_shares_trust_by_where_the_light_splats_fell() {
     // Apart along every axis: in different halves whichever axis splits.
     let (lower, upper) = (Vec3::splat(-5.0), Vec3::splat(5.0));
     let dir = Vec3::new(0.2, 1.0, 0.1);
-    for (p, light_splats) in [(lower, 20), (upper, 980)] {
+    for (p, light_records) in [(lower, 20), (upper, 980)] {
         let v = field.vertex(&ShadingContext::at(p)).unwrap();
         for _ in 0..500 {
             v.direction.record_radiance(dir, 1.0, 1.0);
         }
-        for _ in 0..light_splats {
+        for _ in 0..light_records {
             field.record_light_at(p, LightId::Emitter(3), 2.0);
         }
     }
-    // Before the refinement, one cell counts every splat in the octants
+    // Before the refinement, one cell counts every record in the octants
     // they fell in.
-    let counts = field.spatial().data_slice()[0].octant_splats();
+    let counts = field.spatial().data_slice()[0].octant_records();
     assert_eq!(counts.iter().sum::<u64>(), 1000);
     assert_eq!(counts.iter().filter(|&&c| c > 0).count(), 2, "{counts:?}");
     assert!(counts.contains(&20) && counts.contains(&980), "{counts:?}");
@@ -648,7 +648,7 @@ fn a_split_shares_trust_by_where_the_light_splats_fell() {
     );
     assert_eq!(confidence(upper), 1.0);
     for cell in field.spatial().data_slice() {
-        assert_eq!(cell.octant_splats(), [0; 8], "counts restart");
+        assert_eq!(cell.octant_records(), [0; 8], "counts restart");
     }
 }
 
@@ -683,7 +683,7 @@ fn clearing_records_keeps_what_was_learned() {
     assert_eq!(field.dropped_records().total(), 0);
     for cell in field.spatial().data_slice() {
         assert_eq!(cell.cut().accumulated(), (0.0, 0.0));
-        assert_eq!(cell.octant_splats(), [0; 8]);
+        assert_eq!(cell.octant_records(), [0; 8]);
         assert_eq!(cell.sd().building_weight(), 0.0);
     }
     let after = field
@@ -710,7 +710,7 @@ fn bad_input_is_dropped_and_counted() {
     let p = Vec3::ONE;
     let nan = Vec3::new(f32::NAN, 0.0, 0.0);
     let v = field.vertex(&ShadingContext::at(p)).unwrap();
-    // Radiance splats: position, direction, radiance, pdf, overflow.
+    // Radiance records: position, direction, radiance, pdf, overflow.
     let bad = [
         (nan, Vec3::Z, 1.0, 1.0),
         (Vec3::splat(f32::INFINITY), Vec3::Z, 1.0, 1.0),
@@ -745,7 +745,7 @@ fn bad_input_is_dropped_and_counted() {
     assert!((v.direction.record_fraction(-1.0, 1.0, 1.0) == RecordOutcome::Dropped));
     assert!((v.direction.record_fraction(0.0, 0.0, 1.0) == RecordOutcome::Dropped));
     assert_eq!(field.dropped_records().total(), 16 + 4);
-    // Light splats: values, positions, emitters out of range or dark, the
+    // Light records: values, positions, emitters out of range or dark, the
     // environment without one.
     let lbad = [
         (p, LightId::Emitter(1), f32::NAN),
@@ -781,7 +781,7 @@ fn bad_input_is_dropped_and_counted() {
         v.light.record_light(LightId::Emitter(1), 0.0),
         RecordOutcome::Zero
     );
-    // One report: 20 radiance and fraction records, 20 light splats.
+    // One report: 20 radiance and fraction records, 20 light records.
     assert_eq!(field.dropped_records().total(), 20 + 20);
     // Queries at non-finite points.
     assert!(field.vertex(&ShadingContext::at(nan)).is_none());
@@ -880,7 +880,7 @@ fn fingerprint(field: &GuidingField<&LightTree>) -> Vec<u64> {
     out
 }
 
-/// Splats from several threads (stochastic filters, learned fraction, every
+/// Records from several threads (stochastic filters, learned fraction, every
 /// record through a vertex) equal a serial run in reverse order bit for bit
 /// in deterministic mode: spatial splits, quadtrees, fractions and cuts,
 /// and the sums of an iteration not yet refined.
@@ -919,8 +919,8 @@ fn memory_report_adds_up_and_compares_cuts_with_quadtrees() {
         ..config_with(400.0, sd_config)
     };
     let field = trained_field(&tree, &lights, config, |_, _| {});
-    // An SD-tree fed the same radiance splats: same random stream, and the
-    // light splats (nearest) draw nothing from it.
+    // An SD-tree fed the same radiance records: same random stream, and the
+    // light records (nearest) draw nothing from it.
     let mut sd = SdTree::new(scene(), sd_config).unwrap();
     let mut rng = Rand::seeded(8);
     for it in 0..4 {

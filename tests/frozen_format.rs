@@ -64,7 +64,7 @@ fn glt_configured() -> GltConfig {
             split_prior: SplitPrior::Power,
             unbounded: UnboundedLights::new(2, 0.25).unwrap(),
             accumulation: Accumulation::Deterministic,
-            min_splats: 10,
+            min_records: 10,
             visibility: true,
         },
         spatial_threshold: 300.0,

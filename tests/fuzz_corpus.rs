@@ -3,7 +3,7 @@
 //! run adds what it explores) and `fuzz/artifacts/<target>/` (inputs that
 //! crashed a target: committed, they stay regression tests), without
 //! libFuzzer, and on generated inputs that reach the hard cases (emitters
-//! that are degenerate, coincident, of zero or huge power; splats far
+//! that are degenerate, coincident, of zero or huge power; records far
 //! outside the scene or not finite) without a fuzzing run.
 
 #[path = "../fuzz/checks.rs"]
@@ -155,7 +155,7 @@ fn build_inputs() -> Vec<Vec<u8>> {
 }
 
 /// 32 sequences of 50 to 400 operations in the `operations` layout:
-/// splats (mostly inside the scene, some far outside or not finite),
+/// records (mostly inside the scene, some far outside or not finite),
 /// refinements and queries.
 fn operation_inputs() -> Vec<Vec<u8>> {
     let mut g = Bytes(0x0b5, false);
@@ -165,7 +165,7 @@ fn operation_inputs() -> Vec<Vec<u8>> {
             let n = 50 + g.below(350) as usize;
             let mut out = Vec::new();
             for _ in 0..n {
-                // Refinements are rarer than splats and queries.
+                // Refinements are rarer than records and queries.
                 let kind = if g.below(10) == 0 {
                     2
                 } else {

@@ -1,5 +1,5 @@
 //! The Guiding Light Tree's per-cell core ([`GuidingCut`]): valid cuts under
-//! random splat streams and refinements, the sampling rule's contracts
+//! random record streams and refinements, the sampling rule's contracts
 //! (pmf sums to 1, `sample`'s pmf equals `pmf()` bit for bit), learning,
 //! unbiasedness with the defensive mixture, numerical stability at depth,
 //! across 60 decades and at 1M lights, concurrency and memory.
@@ -244,7 +244,7 @@ fn config_strategy() -> impl Strategy<Value = CutConfig> {
         any::<bool>(),
     )
         .prop_map(
-            |(sigma, alpha, variant, unbounded, exact, min_splats, modulate, prior_imp)| {
+            |(sigma, alpha, variant, unbounded, exact, min_records, modulate, prior_imp)| {
                 let (below_cut, split_prior) = ALL_CONFIGS[variant];
                 CutConfig {
                     sigma,
@@ -262,7 +262,7 @@ fn config_strategy() -> impl Strategy<Value = CutConfig> {
                     } else {
                         Accumulation::Fast
                     },
-                    min_splats,
+                    min_records,
                     prior: if prior_imp {
                         Prior::Importance
                     } else {
@@ -284,7 +284,7 @@ const HEURISTICS: [BuildHeuristic; 4] = [
 proptest! {
     #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
 
-    /// Random light sets, splat streams (bad values and ids included) and
+    /// Random light sets, record streams (bad values and ids included) and
     /// refinement sequences keep every cut valid, the pmf summing to 1 and
     /// sampling agreeing with the pmf bit for bit.
     #[test]
@@ -314,7 +314,7 @@ proptest! {
                     1 => LightId::Emitter(n + id),
                     _ => LightId::Emitter(id % n),
                 };
-                let outcome = guide.splat_from(&cut, rng.point(3.0), light, value.get());
+                let outcome = guide.record_from(&cut, rng.point(3.0), light, value.get());
                 let dark = match light {
                     LightId::Emitter(e) => e >= n || lights[e as usize].power == 0.0,
                     LightId::Unbounded(i) => i >= config.unbounded.count,
@@ -350,7 +350,7 @@ proptest! {
 // ---------------------------------------------------------------------------
 
 /// 64 point lights on a ring; only every 8th is visible from the origin.
-/// Training as a renderer would (sample from the cut, splat
+/// Training as a renderer would (sample from the cut, record
 /// contribution / pmf) moves the pmf mass onto the visible subset, up to
 /// `1 - alpha * (prior mass outside it)`.
 #[test]
@@ -402,7 +402,7 @@ fn learns_the_visible_subset() {
                     } else {
                         0.0
                     };
-                    guide.splat(&cut, s.light, c / s.pmf);
+                    guide.record(&cut, s.light, c / s.pmf);
                 }
                 guide.refine(&mut cut);
             }
@@ -432,8 +432,8 @@ fn power_split_prior_preserves_the_distribution() {
             split_prior: prior,
             sigma: 0.002,
             // The paper's rules: power below the cut, one distribution per
-            // cell, rebuild from any data (here two splats).
-            min_splats: 0,
+            // cell, rebuild from any data (here two records).
+            min_records: 0,
             ..CutConfig::default().with_paper_rules()
         };
         let guide = CutRules::new(&tree, config).unwrap();
@@ -449,8 +449,8 @@ fn power_split_prior_preserves_the_distribution() {
             }
             tree.emitter(n).unwrap()
         };
-        guide.splat(&cut, LightId::Emitter(first_light(l)), tree.power(l));
-        guide.splat(&cut, LightId::Emitter(first_light(r)), tree.power(r));
+        guide.record(&cut, LightId::Emitter(first_light(l)), tree.power(l));
+        guide.record(&cut, LightId::Emitter(first_light(r)), tree.power(r));
         guide.refine(&mut cut);
         assert!(cut.nodes().len() > 50, "{}", cut.nodes().len());
         assert_valid_cut(&tree, &cut);
@@ -467,15 +467,15 @@ fn power_split_prior_preserves_the_distribution() {
     }
 }
 
-/// Below `min_splats` non-zero splats a refine changes nothing and the
+/// Below `min_records` non-zero records a refine changes nothing and the
 /// sums carry over; the rebuild that follows sees every iteration's data.
 #[test]
-fn too_few_splats_defer_the_rebuild_and_keep_the_data() {
+fn too_few_records_defer_the_rebuild_and_keep_the_data() {
     let mut rng = Rand::new(8);
     let lights = lights_in_box(&mut rng, 300, 5.0);
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
     let guide = CutRules::new(&tree, CutConfig::default()).unwrap();
-    let min = guide.config().min_splats;
+    let min = guide.config().min_records;
     assert!(min > 1);
     let mut cut = guide.new_cut();
     let ctx = ShadingContext::at(Vec3::ZERO);
@@ -488,7 +488,7 @@ fn too_few_splats_defer_the_rebuild_and_keep_the_data() {
     // Zeros (occluded samples) are not data.
     for e in 0..300 {
         assert_eq!(
-            guide.splat(&cut, LightId::Emitter(e), 0.0),
+            guide.record(&cut, LightId::Emitter(e), 0.0),
             RecordOutcome::Zero
         );
     }
@@ -496,12 +496,12 @@ fn too_few_splats_defer_the_rebuild_and_keep_the_data() {
     // Half the floor on emitter 17, then the other half on emitter 42:
     // the first refine keeps everything, the second rebuilds from both.
     for _ in 0..min / 2 {
-        guide.splat(&cut, LightId::Emitter(17), 1.0);
+        guide.record(&cut, LightId::Emitter(17), 1.0);
     }
     assert!(!guide.refine(&mut cut));
     assert_eq!(pmfs(&cut), before);
     for _ in 0..min - min / 2 {
-        guide.splat(&cut, LightId::Emitter(42), 1.0);
+        guide.record(&cut, LightId::Emitter(42), 1.0);
     }
     assert!(guide.refine(&mut cut));
     assert_valid_cut(&tree, &cut);
@@ -509,10 +509,10 @@ fn too_few_splats_defer_the_rebuild_and_keep_the_data() {
     // Exactly the cut that all of it in one iteration gives.
     let mut once = guide.new_cut();
     for _ in 0..min / 2 {
-        guide.splat(&once, LightId::Emitter(17), 1.0);
+        guide.record(&once, LightId::Emitter(17), 1.0);
     }
     for _ in 0..min - min / 2 {
-        guide.splat(&once, LightId::Emitter(42), 1.0);
+        guide.record(&once, LightId::Emitter(42), 1.0);
     }
     assert!(guide.refine(&mut once));
     assert_eq!(once.nodes(), cut.nodes());
@@ -531,9 +531,9 @@ fn splits_to_leaves_and_merges_back() {
     let lights = lights_in_box(&mut rng, 300, 5.0);
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
     // The paper's rule: rebuild from any data (the second phase has ten
-    // splats per pass).
+    // records per pass).
     let config = CutConfig {
-        min_splats: 0,
+        min_records: 0,
         ..CutConfig::default()
     };
     let guide = CutRules::new(&tree, config).unwrap();
@@ -541,7 +541,7 @@ fn splits_to_leaves_and_merges_back() {
     // Uniform contributions: every emitter's share 1/300 < sigma, so the cut
     // stops above the leaves but grows large.
     for e in 0..300 {
-        guide.splat(&cut, LightId::Emitter(e), 1.0);
+        guide.record(&cut, LightId::Emitter(e), 1.0);
     }
     guide.refine(&mut cut);
     let wide = cut.nodes().len();
@@ -552,7 +552,7 @@ fn splits_to_leaves_and_merges_back() {
     // siblings got nothing.
     for _ in 0..2 {
         for _ in 0..10 {
-            guide.splat(&cut, LightId::Emitter(17), 5.0);
+            guide.record(&cut, LightId::Emitter(17), 5.0);
         }
         guide.refine(&mut cut);
     }
@@ -596,7 +596,7 @@ fn contribution(light: &Emitter, p: Vec3) -> f64 {
 }
 
 /// The GLT-sampled estimate of direct illumination matches brute force
-/// within 4 standard errors, with delta lights that never received a splat
+/// within 4 standard errors, with delta lights that never received a record
 /// (a renderer that learns only from BSDF hits). With `alpha = 0` those
 /// lights have pmf 0: that estimator would be biased, which this scene
 /// detects.
@@ -641,7 +641,7 @@ fn estimate_is_unbiased_with_the_defensive_mixture() {
                     let e = rng.below(60);
                     if !lights[e as usize].delta {
                         let v = contribution(&lights[e as usize], p) * (0.5 + rng.f() as f64);
-                        guide.splat(&cut, LightId::Emitter(e), v as f32);
+                        guide.record(&cut, LightId::Emitter(e), v as f32);
                     }
                 }
                 guide.refine(&mut cut);
@@ -770,7 +770,7 @@ fn deep_chain_is_exact_in_distribution() {
         let mut cut = guide.new_cut();
         for _ in 0..16 {
             for k in 0..n {
-                guide.splat(&cut, LightId::Emitter(k), Chain::deep_target(k));
+                guide.record(&cut, LightId::Emitter(k), Chain::deep_target(k));
             }
             guide.refine(&mut cut);
         }
@@ -830,10 +830,10 @@ fn sums_across_sixty_decades() {
             for e in 0..500u32 {
                 let decade = (e * 7 + round) % 61;
                 let v = 10f32.powi(decade as i32 - 30);
-                guide.splat(&cut, LightId::Emitter(e), v);
+                guide.record(&cut, LightId::Emitter(e), v);
             }
-            guide.splat(&cut, LightId::Unbounded(0), 1.0e-30);
-            guide.splat(&cut, LightId::Unbounded(1), 1.0e30);
+            guide.record(&cut, LightId::Unbounded(0), 1.0e-30);
+            guide.record(&cut, LightId::Unbounded(1), 1.0e30);
             guide.refine(&mut cut);
             assert_valid_cut(&tree, &cut);
             for _ in 0..3 {
@@ -886,13 +886,13 @@ fn tiny_scenes() {
                     assert!((total - expected_total(&guide)).abs() < 1e-6);
                     assert_sample_matches_pmf(&guide, &cut, &ctx, &mut rng, 50);
                     for e in 0..lights.len() as u32 {
-                        guide.splat(&cut, LightId::Emitter(e), 1.0 + e as f32);
+                        guide.record(&cut, LightId::Emitter(e), 1.0 + e as f32);
                     }
                     if round == 1 {
-                        guide.splat(&cut, LightId::Unbounded(0), 3.0);
+                        guide.record(&cut, LightId::Unbounded(0), 3.0);
                     }
                     if round == 2 {
-                        guide.splat(&cut, LightId::Unbounded(1), 0.5);
+                        guide.record(&cut, LightId::Unbounded(1), 0.5);
                     }
                     guide.refine(&mut cut);
                 }
@@ -912,7 +912,7 @@ fn tiny_scenes() {
     }
 }
 
-/// Subtrees whose emitters all have zero power: never sampled, splats to
+/// Subtrees whose emitters all have zero power: never sampled, records to
 /// them dropped, the rest sums to 1 under both split priors.
 #[test]
 fn zero_power_subtrees() {
@@ -943,7 +943,7 @@ fn zero_power_subtrees() {
         let mut cut = guide.new_cut();
         for _ in 0..3 {
             for e in 0..200u32 {
-                let o = guide.splat(&cut, LightId::Emitter(e), 1.0);
+                let o = guide.record(&cut, LightId::Emitter(e), 1.0);
                 assert_eq!(o == RecordOutcome::Dropped, e < 100);
             }
             guide.refine(&mut cut);
@@ -971,16 +971,16 @@ fn prior_floor_survives_extreme_ratios() {
     ];
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
     // The paper's rules (the power prior), rebuilding from any data (one
-    // splat per pass).
+    // record per pass).
     let config = CutConfig {
-        min_splats: 0,
+        min_records: 0,
         ..CutConfig::default().with_paper_rules()
     };
     let guide = CutRules::new(&tree, config).unwrap();
     let alpha = guide.config().alpha;
     let mut cut = guide.new_cut();
     for _ in 0..3 {
-        guide.splat(&cut, LightId::Emitter(0), 1.0);
+        guide.record(&cut, LightId::Emitter(0), 1.0);
         guide.refine(&mut cut);
     }
     let ctx = ShadingContext::at(Vec3::ONE);
@@ -1022,7 +1022,7 @@ fn a_million_lights() {
             } else {
                 0.0
             };
-            guide.splat(&cut, s.light, v / s.pmf);
+            guide.record(&cut, s.light, v / s.pmf);
         }
         guide.refine(&mut cut);
     }
@@ -1037,7 +1037,7 @@ fn a_million_lights() {
 // Concurrency and memory
 // ---------------------------------------------------------------------------
 
-/// Splats from four threads give the same learned cut as a serial run: bit
+/// Records from four threads give the same learned cut as a serial run: bit
 /// for bit in deterministic mode, to f32 rounding in fast mode.
 #[test]
 fn threads_equal_serial() {
@@ -1067,14 +1067,14 @@ fn threads_equal_serial() {
         for round in 0..3 {
             let chunk = &stream[round * 10_000..(round + 1) * 10_000];
             for &(light, v) in chunk {
-                guide.splat(&serial, light, v);
+                guide.record(&serial, light, v);
             }
             std::thread::scope(|s| {
                 for t in 0..4 {
                     let (cut, guide) = (&parallel, &guide);
                     s.spawn(move || {
                         for &(light, v) in chunk.iter().skip(t).step_by(4) {
-                            guide.splat(cut, light, v);
+                            guide.record(cut, light, v);
                         }
                     });
                 }
@@ -1127,7 +1127,7 @@ fn cut_node_is_twelve_bytes() {
         let guide = CutRules::new(&tree, config).unwrap();
         let mut cut = guide.new_cut();
         for e in 0..100 {
-            guide.splat(&cut, LightId::Emitter(e), 1.0 + (e % 3) as f32);
+            guide.record(&cut, LightId::Emitter(e), 1.0 + (e % 3) as f32);
         }
         guide.refine(&mut cut);
         let m = cut.memory();
@@ -1163,7 +1163,7 @@ fn chain_hierarchy_is_consistent() {
 // ---------------------------------------------------------------------------
 
 /// With [`Modulation::Importance`] the learned distribution is reproduced
-/// at the cell's anchor (the mean splat position) and follows the
+/// at the cell's anchor (the mean record position) and follows the
 /// importance away from it: at the anchor every emitter's pmf equals the
 /// unmodulated cut's (to f32 rounding); near one end of a row of lights the
 /// near lights gain and the second moment of sampling the contributions
@@ -1180,7 +1180,7 @@ fn modulation_reproduces_the_learned_cut_at_the_anchor_and_follows_importance() 
             &tree,
             CutConfig {
                 modulation,
-                min_splats: 0,
+                min_records: 0,
                 sigma: 0.001,
                 ..CutConfig::default()
             },
@@ -1189,25 +1189,25 @@ fn modulation_reproduces_the_learned_cut_at_the_anchor_and_follows_importance() 
     };
     let (plain, modulated) = (make(Modulation::None), make(Modulation::Importance));
     let (mut a, mut b) = (plain.new_cut(), modulated.new_cut());
-    // Every splat is made at the anchor (the middle of the row), with the
+    // Every record is made at the anchor (the middle of the row), with the
     // inverse-square contribution there.
     let anchor = Vec3::new(15.5, 0.0, 0.0);
     for _ in 0..3 {
         for (i, e) in lights.iter().enumerate() {
             let v = 1.0 / (e.bounds.center() - anchor).length_squared();
-            plain.splat_from(&a, anchor, LightId::Emitter(i as u32), v);
-            modulated.splat_from(&b, anchor, LightId::Emitter(i as u32), v);
+            plain.record_from(&a, anchor, LightId::Emitter(i as u32), v);
+            modulated.record_from(&b, anchor, LightId::Emitter(i as u32), v);
         }
         plain.refine(&mut a);
         modulated.refine(&mut b);
     }
-    // Splats without a position leave no anchor: that cut is sampled
+    // Records without a position leave no anchor: that cut is sampled
     // exactly like the unmodulated one.
     let mut c = modulated.new_cut();
     for _ in 0..3 {
         for (i, e) in lights.iter().enumerate() {
             let v = 1.0 / (e.bounds.center() - anchor).length_squared();
-            modulated.splat(&c, LightId::Emitter(i as u32), v);
+            modulated.record(&c, LightId::Emitter(i as u32), v);
         }
         modulated.refine(&mut c);
     }
@@ -1343,8 +1343,8 @@ fn a_cut_as_a_light_sampler_answers_as_its_rules() {
     let mut cut = guide.new_cut();
     for _ in 0..2000 {
         let e = rng.below(200);
-        guide.splat_from(&cut, rng.point(5.0), LightId::Emitter(e), rng.f());
-        guide.splat_visibility(&cut, LightId::Emitter(e), 0.25, 1.0);
+        guide.record_from(&cut, rng.point(5.0), LightId::Emitter(e), rng.f());
+        guide.record_visibility(&cut, LightId::Emitter(e), 0.25, 1.0);
     }
     guide.refine(&mut cut);
     assert!(
@@ -1433,7 +1433,7 @@ fn a_cut_reports_its_fractions_and_memory() {
     let lights = lights_in_box(&mut rng, 40, 4.0);
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
     let config = CutConfig {
-        min_splats: 0,
+        min_records: 0,
         unbounded: UnboundedLights::new(2, 0.1).unwrap(),
         ..CutConfig::default()
     };
@@ -1442,9 +1442,9 @@ fn a_cut_reports_its_fractions_and_memory() {
     assert_eq!(cut.unbounded_fractions(), &[0.05f32, 0.05]);
     // Emitters 1.0 in all, the first unbounded light 3.0, the second none.
     for e in 0..40u32 {
-        guide.splat(&cut, LightId::Emitter(e), 1.0 / 40.0);
+        guide.record(&cut, LightId::Emitter(e), 1.0 / 40.0);
     }
-    guide.splat(&cut, LightId::Unbounded(0), 3.0);
+    guide.record(&cut, LightId::Unbounded(0), 3.0);
     assert!(guide.refine(&mut cut));
     let f = cut.unbounded_fractions();
     assert_eq!(f.len(), 2);
@@ -1491,7 +1491,7 @@ fn a_cut_with_visibility_counts_every_part() {
     let lights = lights_in_box(&mut rng, 60, 4.0);
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
     let config = CutConfig {
-        min_splats: 0,
+        min_records: 0,
         visibility: true,
         unbounded: UnboundedLights::new(3, 0.1).unwrap(),
         ..CutConfig::default()
@@ -1501,13 +1501,13 @@ fn a_cut_with_visibility_counts_every_part() {
     for round in 0..2 {
         for e in 0..60u32 {
             let l = LightId::Emitter(e);
-            guide.splat_from(&cut, rng.point(3.0), l, 1.0 + e as f32);
+            guide.record_from(&cut, rng.point(3.0), l, 1.0 + e as f32);
             for k in 0..4 {
                 let seen = if k == 0 { 1.0 } else { 0.0 };
-                guide.splat_visibility(&cut, l, seen, 1.0);
+                guide.record_visibility(&cut, l, seen, 1.0);
             }
         }
-        guide.splat(&cut, LightId::Unbounded(1), 30.0);
+        guide.record(&cut, LightId::Unbounded(1), 30.0);
         assert!(guide.refine(&mut cut), "round {round}");
     }
     let n = cut.nodes().len();
@@ -1524,8 +1524,8 @@ fn a_cut_with_visibility_counts_every_part() {
     assert!(m.sum_bytes > 2 * n * 8, "{m:?}");
 }
 
-/// The anchor (the mean position a cell's splats came from) ignores
-/// splats from non-finite positions entirely: their weight does not
+/// The anchor (the mean position a cell's records came from) ignores
+/// records from non-finite positions entirely: their weight does not
 /// dilute the mean of the others.
 #[test]
 fn the_anchor_ignores_non_finite_positions() {
@@ -1537,17 +1537,17 @@ fn the_anchor_ignores_non_finite_positions() {
     assert_eq!(cut.anchor(), None);
     let at = Vec3::new(2.0, -4.0, 6.0);
     for p in [at, Vec3::NAN, at, Vec3::new(f32::INFINITY, 0.0, 0.0), at] {
-        guide.splat_from(&cut, p, LightId::Emitter(3), 1.0);
+        guide.record_from(&cut, p, LightId::Emitter(3), 1.0);
     }
-    // Splats that record nothing (a zero value, a dropped one) do not
+    // Records that record nothing (a zero value, a dropped one) do not
     // move it either.
     let elsewhere = Vec3::new(-5.0, 5.0, -5.0);
     assert_eq!(
-        guide.splat_from(&cut, elsewhere, LightId::Emitter(3), 0.0),
+        guide.record_from(&cut, elsewhere, LightId::Emitter(3), 0.0),
         RecordOutcome::Zero
     );
     assert_eq!(
-        guide.splat_from(&cut, elsewhere, LightId::Emitter(3), -1.0),
+        guide.record_from(&cut, elsewhere, LightId::Emitter(3), -1.0),
         RecordOutcome::Dropped
     );
     assert_eq!(cut.anchor(), Some(at));
@@ -1574,12 +1574,12 @@ fn box_filter_glt<'a>(tree: &'a LightTree, rng: &mut Rand) -> guiding::glt::Glt<
     glt
 }
 
-/// With the box filter a splat is shared among the cells its box overlaps,
+/// With the box filter a record is shared among the cells its box overlaps,
 /// each taking a fraction of its weight; the anchor of each is still the
-/// position the splats came from (the position weighted by its share, over
+/// position the records came from (the position weighted by its share, over
 /// the shares), whatever the shares.
 #[test]
-fn shared_splats_anchor_where_they_came_from() {
+fn shared_records_anchor_where_they_came_from() {
     let mut rng = Rand::new(12);
     let tree = LightTree::build(&lights_in_box(&mut rng, 30, 8.0), BuildHeuristic::Sarh).unwrap();
     let glt = box_filter_glt(&tree, &mut rng);
@@ -1592,7 +1592,7 @@ fn shared_splats_anchor_where_they_came_from() {
         for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
             let cut = glt.vertex(&ShadingContext::at(p + d * axis)).unwrap().cut();
             if let Some(a) = cut.anchor() {
-                assert!((a - p).length() < 1e-5, "anchor {a} for splats from {p}");
+                assert!((a - p).length() < 1e-5, "anchor {a} for records from {p}");
                 anchored += 1;
             }
         }
@@ -1726,7 +1726,7 @@ fn each_importance_rule_works_alone_and_only_they_pay_for_the_table() {
         for k in 0..4000u32 {
             let e = k % 16;
             let value = 1.0 / (1.0 + at(e).length_squared());
-            guide.splat_from(&cut, Vec3::ZERO, LightId::Emitter(e), value);
+            guide.record_from(&cut, Vec3::ZERO, LightId::Emitter(e), value);
         }
         let mut cut = cut;
         assert!(guide.refine(&mut cut));
@@ -1774,30 +1774,30 @@ fn a_cut_that_collected_nothing_from_emitters_keeps_its_nodes() {
         .collect();
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
     let config = CutConfig {
-        min_splats: 0,
+        min_records: 0,
         unbounded: UnboundedLights::new(1, 0.1).unwrap(),
         ..CutConfig::default()
     };
     let guide = CutRules::new(&tree, config).unwrap();
     let mut cut = guide.new_cut();
     for k in 0..800u32 {
-        guide.splat(&cut, LightId::Emitter(k % 16), 1.0 + (k % 16) as f32);
+        guide.record(&cut, LightId::Emitter(k % 16), 1.0 + (k % 16) as f32);
     }
-    guide.splat(&cut, LightId::Unbounded(0), 40.0);
+    guide.record(&cut, LightId::Unbounded(0), 40.0);
     assert!(guide.refine(&mut cut));
     let (nodes, fractions) = (cut.nodes().to_vec(), cut.unbounded_fractions().to_vec());
     assert!(nodes.len() > 2 && fractions[0] > 0.0 && fractions[0] < 0.1);
     for e in 0..16 {
-        guide.splat(&cut, LightId::Emitter(e), 0.0);
+        guide.record(&cut, LightId::Emitter(e), 0.0);
     }
-    guide.splat(&cut, LightId::Unbounded(0), 0.0);
+    guide.record(&cut, LightId::Unbounded(0), 0.0);
     assert!(!guide.refine(&mut cut));
     assert_eq!(
         (cut.nodes(), cut.unbounded_fractions()),
         (&nodes[..], &fractions[..])
     );
     for _ in 0..100 {
-        guide.splat(&cut, LightId::Unbounded(0), 2.0);
+        guide.record(&cut, LightId::Unbounded(0), 2.0);
     }
     assert!(!guide.refine(&mut cut));
     assert_eq!(

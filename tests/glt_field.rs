@@ -1,6 +1,6 @@
 //! The Guiding Light Tree over its own spatial tree ([`Glt`]): the
 //! light-sampler contract at random points, learning that differs across
-//! space, spatial refinement copying cuts, jittered splats, bad input
+//! space, spatial refinement copying cuts, jittered records, bad input
 //! counted, threads equal a serial run, and the memory report.
 
 use glam::Vec3;
@@ -20,7 +20,7 @@ use common::{ByPosition, LightsAt};
 use common::{Rand, scene, two_rooms, value};
 
 /// Trains `glt` for `iterations` iterations of `per_iteration` jittered
-/// splats, sampling lights from the GLT itself as a renderer would.
+/// records, sampling lights from the GLT itself as a renderer would.
 fn train<H: LightHierarchy>(
     glt: &mut Glt<H>,
     lights: &[Emitter],
@@ -125,7 +125,7 @@ fn split_cells_inherit_the_cut_where_its_records_came_from() {
     };
     let prior = Glt::new(&tree, scene(), config).unwrap();
     let mut glt = prior.clone();
-    // All splats in one corner, all for light 3: the root cell splits; its
+    // All records in one corner, all for light 3: the root cell splits; its
     // halves refine from the same sums.
     let p = Vec3::new(-9.0, -9.0, -9.0);
     let near = ShadingContext::at(p);
@@ -140,7 +140,7 @@ fn split_cells_inherit_the_cut_where_its_records_came_from() {
     assert!(first.len() > 1);
     for cell in glt.spatial().data_slice() {
         assert_eq!(cell.cut().nodes(), &first[..]);
-        assert_eq!(cell.splats(), 0);
+        assert_eq!(cell.records(), 0);
     }
     let at = |glt: &Glt<&LightTree>, ctx: &ShadingContext| {
         let cell = glt.locate(ctx.position).unwrap();
@@ -194,7 +194,7 @@ fn split_cells_inherit_the_cut_where_its_records_came_from() {
     );
 }
 
-/// The stochastic box: splats near a cell border land on both sides, in
+/// The stochastic box: records near a cell border land on both sides, in
 /// proportion to the overlap of the +-1/2-cell box with each; the
 /// deterministic variant never crosses.
 #[test]
@@ -230,7 +230,7 @@ fn jitter_spreads_over_neighbouring_cells() {
         .spatial()
         .data_slice()
         .iter()
-        .map(|c| c.splats())
+        .map(|c| c.records())
         .collect();
     let other = 1 - here.index();
     // A box of one cell width centred a quarter cell from the border
@@ -243,7 +243,7 @@ fn jitter_spreads_over_neighbouring_cells() {
 /// negative values, non-finite positions, emitters out of range or with
 /// zero power, unbounded lights when none is configured.
 #[test]
-fn bad_splats_are_counted() {
+fn bad_records_are_counted() {
     let mut lights = two_rooms();
     lights[5].power = 0.0;
     let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
@@ -286,7 +286,7 @@ fn bad_splats_are_counted() {
         .cut()
         .accumulated();
     assert_eq!((emitters, env), (1.0, 0.0));
-    assert_eq!(glt.spatial().data_slice()[0].splats(), 2);
+    assert_eq!(glt.spatial().data_slice()[0].records(), 2);
     // Queries at non-finite points: nothing, consistently.
     let nan = ShadingContext::at(Vec3::splat(f32::NAN));
     assert!(ByPosition(&glt).sample(&nan, 0.5).is_none());
@@ -371,7 +371,7 @@ fn unbounded_shares_are_learned() {
     assert!((a - b).abs() < 1e-6 && a > 0.4, "{a} {b}");
 }
 
-/// Jitter-free splats from four threads equal a serial run: bit for bit in
+/// Jitter-free records from four threads equal a serial run: bit for bit in
 /// deterministic mode, including the spatial splits and cell counts.
 #[test]
 fn threads_equal_serial() {
@@ -466,8 +466,8 @@ fn memory_report_adds_up() {
 }
 
 /// One refinement splits a cell as many levels deep as its count allows,
-/// each half taken to have half its parent's splats (PPG's rule): 1,000
-/// splats at threshold 100 split the root while the count is above it
+/// each half taken to have half its parent's records (PPG's rule): 1,000
+/// records at threshold 100 split the root while the count is above it
 /// (1,000, 500, 250, 125; not 62), 4 levels, 1 + 2 + 4 + 8 = 15 splits.
 #[test]
 fn one_refinement_splits_as_deep_as_the_count_allows() {
@@ -485,7 +485,7 @@ fn one_refinement_splits_as_deep_as_the_count_allows() {
     assert_eq!((out.splits, out.refused_by_budget), (15, 0));
     assert_eq!(glt.spatial().cell_count(), 16);
     // Every cell took part, so its next threshold is 100 sqrt(2) = 141.4:
-    // 142 splats in the far corner's cell (none of the first 1,000 fell
+    // 142 records in the far corner's cell (none of the first 1,000 fell
     // there, so any number makes it take part) split it once more, its
     // halves' 71 do not split them.
     for _ in 0..142 {
@@ -495,7 +495,7 @@ fn one_refinement_splits_as_deep_as_the_count_allows() {
     // The first corner's cell holds its share of the first 1,000: all of
     // them for three splits (x, y, z: its octants tell), half at the
     // fourth (along x again, where its octants no longer tell): 500. So
-    // 749 more splats do not make it take part, 750 do.
+    // 749 more records do not make it take part, 750 do.
     let corner = Vec3::new(-9.0, -9.0, -9.0);
     for _ in 0..749 {
         glt.record_light_at(corner, LightId::Emitter(3), 2.0);

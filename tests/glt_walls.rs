@@ -1,13 +1,13 @@
 //! Learning never carries light through walls: a sealed, dim room between
 //! two sealed rooms full of bright lights must learn its own lights with
-//! the GLT's default splat, not the neighbours' (which it cannot see).
+//! the GLT's default record, not the neighbours' (which it cannot see).
 //!
 //! The scene is analytic: small sphere lights near the ceilings of four
 //! rooms side by side along x (the walls lie on the spatial tree's split
 //! planes), shading points on the floors, a light reaches a point only in
 //! its own room. Training is what a renderer does: at each point one NEE
-//! sample from the GLT (splat contribution / pmf where the light is
-//! visible) and one cosine-distributed "BSDF" direction (splat what it
+//! sample from the GLT (record contribution / pmf where the light is
+//! visible) and one cosine-distributed "BSDF" direction (record what it
 //! hits, radiance x cos / pdf), refine after each iteration of 2^k
 //! batches. The variance at the dim room's points is then computed exactly
 //! from every light's contribution.
@@ -124,8 +124,8 @@ fn variance(lights: &[Emitter], p: Vec3, pmf: impl Fn(LightId) -> f64) -> f64 {
     m2 - mean * mean
 }
 
-/// Trains a GLT with `config` and `filter` on the three rooms, splatting
-/// through `Glt::splat`; the dim room's variance relative to power
+/// Trains a GLT with `config` and `filter` on the three rooms, recording
+/// through `LightVertex::record_light`; the dim room's variance relative to power
 /// sampling's.
 fn dim_room_ratio(config: CutConfig, filter: SpatialFilter) -> f64 {
     let lights = rooms();
@@ -175,9 +175,9 @@ fn dim_room_ratio(config: CutConfig, filter: SpatialFilter) -> f64 {
     v_glt / v_power
 }
 
-/// The dim room learns its own lights with the default splat: its
+/// The dim room learns its own lights with the default record: its
 /// variance is at most 2e-5 of power sampling's (the bar was 1/10;
-/// nearest splats give 6.3e-6 without modulation and 3.9e-6 with it, so
+/// nearest records give 6.3e-6 without modulation and 3.9e-6 with it, so
 /// a change that triples either fails here), with and without modulation.
 #[test]
 fn dim_room_beside_bright_rooms_learns_its_own_lights() {
@@ -195,12 +195,12 @@ fn dim_room_beside_bright_rooms_learns_its_own_lights() {
     }
 }
 
-/// The control that shows the test above can fail: jittered splats
+/// The control that shows the test above can fail: jittered records
 /// (PPG's stochastic box) carry the bright rooms' lights through the walls
 /// into the dim room's cells by the walls, whose variance then dominates
 /// (about 0.08 of power's here, 10,000x the nearest filter's).
 #[test]
-fn jittered_splats_leak_through_walls() {
+fn jittered_records_leak_through_walls() {
     let ratio = dim_room_ratio(CutConfig::default(), SpatialFilter::StochasticBox);
     assert!(ratio > 1e-2, "stochastic box: GLT / power variance {ratio}");
 }

@@ -17,7 +17,7 @@ use guiding::light_tree::BuildHeuristic;
 use guiding::sd_tree::{SdTree, SdTreeConfig};
 use guiding::{Emitter, LightChoice, LightId, LightTree, ShadingContext};
 
-/// A light at `p` chosen by `sampler`, and its splat value.
+/// A light at `p` chosen by `sampler`, and its record value.
 fn light_record(
     lights_here: &impl LightChoice,
     lights: &[Emitter],
@@ -48,7 +48,7 @@ fn train_glt(lights: &[Emitter], tree: &LightTree, max_bytes: Option<usize>) -> 
     let config = GltConfig {
         cut: CutConfig {
             sigma: 0.001,
-            min_splats: 0,
+            min_records: 0,
             ..CutConfig::default()
         },
         spatial_threshold: 400.0,
@@ -141,7 +141,7 @@ fn train_field(lights: &[Emitter], tree: &LightTree, max_bytes: Option<usize>) -
     config.sd.quadtree.rho = 0.002;
     config.sd.max_bytes = max_bytes;
     config.cut.sigma = 0.001;
-    config.cut.min_splats = 0;
+    config.cut.min_records = 0;
     let mut field = GuidingField::new(tree, scene(), config).unwrap();
     let mut rng = Rand::new(7);
     let mut after = Vec::new();

@@ -19,7 +19,7 @@ use guiding::sd_tree::{SdTree, SdTreeConfig};
 use guiding::{LightId, LightTree};
 
 /// One sample's records: a position, a light and its value, a direction
-/// and its radiance, and the numbers a jittered splat draws.
+/// and its radiance, and the numbers a jittered record draws.
 #[derive(Clone, Copy)]
 struct Sample {
     p: Vec3,
@@ -209,7 +209,7 @@ fn glt_workers_merge_bit_for_bit() {
             accumulation: Accumulation::Deterministic,
             // Many cuts stay below the floor and carry their sums into the
             // next iteration: a share must not carry them again.
-            min_splats: 300,
+            min_records: 300,
             visibility: true,
             ..CutConfig::default()
         },

@@ -387,8 +387,8 @@ fn corrupted_and_hostile_buffers_never_panic() {
                         loaded += 1;
                         assert_contract(&g, lights.len() as u32, &mut rng);
                         // And it can go on recording. (Not refining: a
-                        // rewritten splat count of 2^60 makes the next
-                        // refine split the cell as 2^60 splats would;
+                        // rewritten record count of 2^60 makes the next
+                        // refine split the cell as 2^60 records would;
                         // see the persist module docs.)
                         record(&g, &lights, &mut rng, 50);
                         assert_contract(&g, lights.len() as u32, &mut rng);

@@ -72,15 +72,15 @@ fn train(
     config: &QuadtreeConfig,
     seed: u64,
     iterations: u32,
-    splats: usize,
+    records: usize,
 ) -> DirectionalTree {
     let mut r = rng(seed);
     let scene = Scene::random(&mut r);
     let mut tree = DirectionalTree::new(mode);
     for k in 0..iterations {
-        for _ in 0..splats << k.min(3) {
+        for _ in 0..records << k.min(3) {
             let (dir, value) = scene.draw(&mut r);
-            assert!(tree.splat(dir, value, filter));
+            assert!(tree.record(dir, value, filter));
         }
         tree.refine(config);
     }
@@ -316,7 +316,7 @@ fn refinement_preserves_power_merges_and_bounds_depth() {
             let scene = Scene::random(&mut r);
             for _ in 0..20_000 {
                 let (dir, value) = scene.draw(&mut r);
-                tree.splat(dir, value, filter);
+                tree.record(dir, value, filter);
             }
             let before = tree.building_leaves();
             let total = tree.building_total();
@@ -389,7 +389,7 @@ fn quarter_initialisation_splits_a_bright_leaf_several_levels() {
     for mode in [Accumulation::Fast, Accumulation::Deterministic] {
         let mut tree = DirectionalTree::new(mode);
         for _ in 0..10 {
-            tree.splat(Vec3::new(0.2, 0.1, 0.97), 3.0, DirectionalFilter::Nearest);
+            tree.record(Vec3::new(0.2, 0.1, 0.97), 3.0, DirectionalFilter::Nearest);
         }
         let mut capped = tree.clone();
         tree.refine(&QuadtreeConfig::default());
@@ -417,7 +417,7 @@ fn old_subtrees_merge_when_their_light_goes() {
     let down = Vec3::new(-0.3, 0.1, -0.9).normalize();
     for _ in 0..3 {
         for _ in 0..100 {
-            tree.splat(up, 1.0, DirectionalFilter::Nearest);
+            tree.record(up, 1.0, DirectionalFilter::Nearest);
         }
         tree.refine(&config);
     }
@@ -431,7 +431,7 @@ fn old_subtrees_merge_when_their_light_goes() {
     };
     assert!(holder(&tree, up) > 10);
     for _ in 0..100 {
-        tree.splat(down, 1.0, DirectionalFilter::Nearest);
+        tree.record(down, 1.0, DirectionalFilter::Nearest);
     }
     tree.refine(&config);
     // The upper hemisphere's quadrants got nothing: merged to one level.
@@ -456,8 +456,8 @@ fn empty_iteration_keeps_the_learned_distribution() {
     let sampling = tree.sampling_leaves();
     let building = tree.building_leaves();
     let total = tree.sampling_total();
-    // Zero-valued splats are accepted but carry nothing.
-    assert!(tree.splat(Vec3::X, 0.0, DirectionalFilter::Nearest));
+    // Zero-valued records are accepted but carry nothing.
+    assert!(tree.record(Vec3::X, 0.0, DirectionalFilter::Nearest));
     tree.refine(&config);
     assert_eq!(tree.sampling_total(), total);
     assert_eq!(tree.sampling_leaves(), sampling);
@@ -480,10 +480,10 @@ fn learns_three_directions() {
             for _ in 0..3000 {
                 let k = r.next_u32() as usize % 3;
                 let jitter = 0.01 * unit(&mut r) * random_dir(&mut r);
-                tree.splat((dirs[k] + jitter).normalize(), (k + 1) as f32, filter);
+                tree.record((dirs[k] + jitter).normalize(), (k + 1) as f32, filter);
                 // A dim background: 1% of the power.
                 if r.next_u32() % 10 == 0 {
-                    tree.splat(random_dir(&mut r), 0.2, filter);
+                    tree.record(random_dir(&mut r), 0.2, filter);
                 }
             }
             tree.refine(&QuadtreeConfig::default());
@@ -524,14 +524,14 @@ fn bad_input_is_rejected_and_changes_nothing() {
     for mode in [Accumulation::Fast, Accumulation::Deterministic] {
         for filter in FILTERS {
             let mut tree = train(mode, filter, &config, 12, 2, 2000);
-            tree.splat(Vec3::Y, 2.0, filter);
+            tree.record(Vec3::Y, 2.0, filter);
             let leaves = tree.building_leaves();
             let total = tree.building_total();
             for v in bad_values {
-                assert!(!tree.splat(Vec3::Y, v, filter), "value {v}");
+                assert!(!tree.record(Vec3::Y, v, filter), "value {v}");
             }
             for d in bad_dirs {
-                assert!(!tree.splat(d, 1.0, filter), "dir {d}");
+                assert!(!tree.record(d, 1.0, filter), "dir {d}");
                 assert_eq!(tree.pdf(d), 0.0);
             }
             assert_eq!(tree.building_total().to_bits(), total.to_bits());
@@ -555,7 +555,7 @@ fn bad_input_is_rejected_and_changes_nothing() {
                 assert!(pdf > 0.0 && pdf == tree.pdf(dir), "{u:?}: {pdf}");
             }
             // Only rejected input this iteration: refining it is an empty
-            // iteration apart from the one good splat.
+            // iteration apart from the one good record.
             tree.refine(&config);
             assert_eq!(tree.sampling_total(), total);
         }
@@ -567,7 +567,7 @@ fn pdf_is_positive_where_nothing_was_learned() {
     let mut tree = DirectionalTree::new(Accumulation::Fast);
     for _ in 0..4 {
         for _ in 0..100 {
-            tree.splat(Vec3::Z, 1.0, DirectionalFilter::Nearest);
+            tree.record(Vec3::Z, 1.0, DirectionalFilter::Nearest);
         }
         tree.refine(&QuadtreeConfig::default());
     }
@@ -579,9 +579,9 @@ fn pdf_is_positive_where_nothing_was_learned() {
     assert!((tree.pdf(Vec3::Z) - UNIFORM_PDF).abs() < 1e-7);
 }
 
-/// The splat stream the concurrency test replays: values over many orders of
+/// The record stream the concurrency test replays: values over many orders of
 /// magnitude, both filters.
-fn splat_stream(seed: u64, n: usize) -> Vec<(Vec3, f32, DirectionalFilter)> {
+fn record_stream(seed: u64, n: usize) -> Vec<(Vec3, f32, DirectionalFilter)> {
     let mut r = rng(seed);
     let scene = Scene::random(&mut r);
     (0..n)
@@ -593,7 +593,7 @@ fn splat_stream(seed: u64, n: usize) -> Vec<(Vec3, f32, DirectionalFilter)> {
         .collect()
 }
 
-fn splat_threaded(
+fn record_threaded(
     tree: &DirectionalTree,
     stream: &[(Vec3, f32, DirectionalFilter)],
     threads: usize,
@@ -605,7 +605,7 @@ fn splat_threaded(
                 // differs from the single-threaded one.
                 for i in (0..stream.len()).rev().filter(|i| i % threads == t) {
                     let (d, v, f) = stream[i];
-                    assert!(tree.splat(d, v, f));
+                    assert!(tree.record(d, v, f));
                 }
             });
         }
@@ -615,15 +615,15 @@ fn splat_threaded(
 #[test]
 fn threads_give_the_same_state_as_one_thread() {
     let config = QuadtreeConfig::default();
-    let stream = splat_stream(13, 40_000);
+    let stream = record_stream(13, 40_000);
     for mode in [Accumulation::Deterministic, Accumulation::Fast] {
         let base = train(mode, DirectionalFilter::Nearest, &config, 14, 3, 3000);
         let single = base.clone();
         for &(d, v, f) in &stream {
-            single.splat(d, v, f);
+            single.record(d, v, f);
         }
         let multi = base.clone();
-        splat_threaded(&multi, &stream, 4);
+        record_threaded(&multi, &stream, 4);
         let (a, b) = (single.building_leaves(), multi.building_leaves());
         assert_same_leaves(&a, &b);
         let (ta, tb) = (single.building_total(), multi.building_total());
@@ -670,7 +670,7 @@ fn deep_trees_with_more_than_65535_nodes() {
     let mut tree = DirectionalTree::new(Accumulation::Fast);
     let grid = 512;
     for _ in 0..5 {
-        // An even background: one splat per cell of a 512^2 grid, so every
+        // An even background: one record per cell of a 512^2 grid, so every
         // level-8 cell holds 4 (share > rho) and every level-9 cell 1 (< rho).
         for i in 0..grid {
             for j in 0..grid {
@@ -678,11 +678,11 @@ fn deep_trees_with_more_than_65535_nodes() {
                     (i as f32 + 0.5) / grid as f32,
                     (j as f32 + 0.5) / grid as f32,
                 );
-                tree.splat(canonical_to_dir(c), 1.0, DirectionalFilter::Nearest);
+                tree.record(canonical_to_dir(c), 1.0, DirectionalFilter::Nearest);
             }
         }
         for s in spikes {
-            tree.splat(s, 0.05 * (grid * grid) as f32, DirectionalFilter::Nearest);
+            tree.record(s, 0.05 * (grid * grid) as f32, DirectionalFilter::Nearest);
         }
         tree.refine(&config);
     }
@@ -715,7 +715,7 @@ fn deep_trees_with_more_than_65535_nodes() {
         deep += (pdf > 1e6 * UNIFORM_PDF) as usize;
     }
     assert!(deep > 5_000, "{deep}");
-    assert!(tree.splat(spikes[0], 1.0, DirectionalFilter::Box));
+    assert!(tree.record(spikes[0], 1.0, DirectionalFilter::Box));
     assert!(tree.building_total() > 0.0);
 }
 
@@ -780,7 +780,7 @@ fn box_filter_spreads_by_overlap_and_keeps_the_mass() {
         let c = dir_to_canonical(dir);
         let value = 0.5 + 10.0 * unit(&mut r);
         let t = tree.clone();
-        assert!(t.splat(dir, value, DirectionalFilter::Box));
+        assert!(t.record(dir, value, DirectionalFilter::Box));
         let total = t.building_total();
         assert!(
             (total - value as f64).abs() <= 1e-6 * value as f64,
@@ -814,7 +814,7 @@ fn clone_copies_both_copies() {
     let scene = Scene::random(&mut r);
     let stream: Vec<_> = (0..5000).map(|_| scene.draw(&mut r)).collect();
     for &(d, v) in &stream[..2500] {
-        tree.splat(d, v, DirectionalFilter::Box);
+        tree.record(d, v, DirectionalFilter::Box);
     }
     let mut a = tree.clone();
     let mut b = tree.clone();
@@ -823,8 +823,8 @@ fn clone_copies_both_copies() {
     // The clones are independent of the original.
     let before = tree.building_leaves();
     for &(d, v) in &stream[2500..] {
-        a.splat(d, v, DirectionalFilter::Box);
-        b.splat(d, v, DirectionalFilter::Box);
+        a.record(d, v, DirectionalFilter::Box);
+        b.record(d, v, DirectionalFilter::Box);
     }
     assert_eq!(tree.building_leaves(), before);
     a.refine(&config);

@@ -41,7 +41,7 @@ fn lobe_dir(rng: &mut Pcg32) -> Vec3 {
     (l + 0.05 * n).normalize()
 }
 
-/// Splats `n` lobe directions at random points, radiance 1 sampled
+/// Records `n` lobe directions at random points, radiance 1 sampled
 /// uniformly (pdf 1 / 4 pi).
 fn train(tree: &SdTree, n: usize, seed: u64) {
     let mut rng = Pcg32::seed_from_u64(seed);
@@ -141,7 +141,7 @@ fn sampled_pdf_equals_pdf() {
 }
 
 #[test]
-fn learning_concentrates_on_the_splatted_directions() {
+fn learning_concentrates_on_the_recorded_directions() {
     let t = trained(1.0e9);
     assert_eq!(t.cell_count(), 1);
     let p = Vec3::ZERO;
@@ -173,7 +173,7 @@ fn learning_concentrates_on_the_splatted_directions() {
     assert!(near > 1600, "{near} of 2000");
 }
 
-fn splat_n(t: &SdTree, p: Vec3, n: usize) {
+fn record_n(t: &SdTree, p: Vec3, n: usize) {
     for _ in 0..n {
         assert_ne!(
             t.record_radiance_at(p, Vec3::Z, 1.0, 1.0),
@@ -187,7 +187,7 @@ fn spatial_split_exactly_above_threshold_copies_and_halves() {
     let p = Vec3::new(0.5, 0.5, 0.5);
     // Iteration 0: threshold c = 100.
     let mut t = SdTree::new(scene(), config(100.0)).unwrap();
-    splat_n(&t, p, 100);
+    record_n(&t, p, 100);
     assert_eq!(
         t.vertex(&ShadingContext::at(p))
             .unwrap()
@@ -198,11 +198,11 @@ fn spatial_split_exactly_above_threshold_copies_and_halves() {
     assert_eq!(t.refine().splits, 0);
     assert_eq!(t.cell_count(), 1);
     // Iteration 1: threshold 100 sqrt 2 = 141.42.
-    splat_n(&t, p, 141);
+    record_n(&t, p, 141);
     assert_eq!(t.refine().splits, 0);
     assert_eq!(t.iteration(), 2);
-    // Iteration 2: threshold 200; 201 splats split once (100.5 each).
-    splat_n(&t, p, 201);
+    // Iteration 2: threshold 200; 201 records split once (100.5 each).
+    record_n(&t, p, 201);
     assert_eq!(t.refine().splits, 1);
     assert_eq!(t.cell_count(), 2);
     let tree = t.spatial();
@@ -217,12 +217,12 @@ fn spatial_split_exactly_above_threshold_copies_and_halves() {
 
     // Recursive in one pass: 450 -> 225 -> 112.5 -> 56.25 against 100.
     let mut t = SdTree::new(scene(), config(100.0)).unwrap();
-    splat_n(&t, p, 450);
+    record_n(&t, p, 450);
     assert_eq!(t.refine().splits, 7);
     assert_eq!(t.cell_count(), 8);
     // 400 -> 200 -> 100 (not above): two levels.
     let mut t = SdTree::new(scene(), config(100.0)).unwrap();
-    splat_n(&t, p, 400);
+    record_n(&t, p, 400);
     assert_eq!(t.refine().splits, 3);
     let c = SdTreeConfig::default();
     assert_eq!(c.split_threshold(0), 12000.0);
@@ -390,7 +390,7 @@ fn box_filters_spread_weight_by_overlap() {
             ..config(10.0)
         };
         let mut t = SdTree::new(scene(), filtered).unwrap();
-        splat_n(&t, Vec3::ZERO, 40);
+        record_n(&t, Vec3::ZERO, 40);
         assert_eq!(t.refine().splits, 3);
         assert_eq!(t.cell_count(), 4);
         t
@@ -667,7 +667,7 @@ fn threads_learn_exactly_what_one_thread_learns() {
         fingerprint(&train_threaded(boxed, &data, 4))
     );
 
-    // Fast mode loses no update: the weights of unit splats add exactly.
+    // Fast mode loses no update: the weights of unit records add exactly.
     let fast = SdTreeConfig {
         accumulation: Accumulation::Fast,
         spatial_filter: SpatialFilter::Nearest,

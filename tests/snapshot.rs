@@ -596,7 +596,7 @@ fn a_deep_chain_is_sampled_in_distribution() {
     ] {
         let config = GltConfig {
             cut: CutConfig {
-                min_splats: 0,
+                min_records: 0,
                 ..cut
             },
             ..GltConfig::default()

@@ -109,7 +109,7 @@ fn the_glt_strategy_trains() {
             .is_none()
     );
     let mut rng = Rand::new(1);
-    // Enough splats per iteration for the default threshold (12000) to
+    // Enough records per iteration for the default threshold (12000) to
     // split the scene at the wall.
     for _ in 0..4 {
         let glt = s.glt_mut().unwrap();

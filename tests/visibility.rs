@@ -288,10 +288,10 @@ fn the_learned_visibility_is_the_shrunk_ratio() {
     let mut cut = guide.new_cut();
     let l = LightId::Emitter(0);
     let round = |records: &[(f32, f32)], cut: &mut guiding::cut::GuidingCut| {
-        guide.splat(cut, l, 1.0);
+        guide.record(cut, l, 1.0);
         for &(s, u) in records {
             assert_eq!(
-                guide.splat_visibility(cut, l, s, u),
+                guide.record_visibility(cut, l, s, u),
                 RecordOutcome::Recorded
             );
         }
@@ -323,10 +323,10 @@ fn a_coarser_cut_keeps_what_its_finer_slots_learned() {
         for e in lit {
             let l = LightId::Emitter(e);
             for _ in 0..8 {
-                guide.splat(cut, l, 100.0);
+                guide.record(cut, l, 100.0);
                 // The left half is hidden, the right half seen.
                 let seen = if e < 8 { 0.0 } else { 1.0 };
-                guide.splat_visibility(cut, l, seen, 1.0);
+                guide.record_visibility(cut, l, seen, 1.0);
             }
         }
         guide.refine(cut);
@@ -359,18 +359,18 @@ fn a_coarser_slot_weighs_its_old_slots_by_their_records() {
     let tree = row_of_lights();
     let guide = guiding::cut::CutRules::new(&tree, learning_visibility()).unwrap();
     let mut cut = guide.new_cut();
-    // Lights 0-3 hidden, 4-15 seen; `splat` says which lights the cut
+    // Lights 0-3 hidden, 4-15 seen; `record` says which lights the cut
     // resolves, `records` which send visibility records.
-    let round = |splat: std::ops::Range<u32>,
+    let round = |record: std::ops::Range<u32>,
                  records: std::ops::Range<u32>,
                  cut: &mut guiding::cut::GuidingCut| {
-        for e in splat {
-            guide.splat(cut, LightId::Emitter(e), 100.0);
+        for e in record {
+            guide.record(cut, LightId::Emitter(e), 100.0);
         }
         for e in records {
             let seen = if e < 4 { 0.0 } else { 1.0 };
             for _ in 0..8 {
-                guide.splat_visibility(cut, LightId::Emitter(e), seen, 1.0);
+                guide.record_visibility(cut, LightId::Emitter(e), seen, 1.0);
             }
         }
         guide.refine(cut);
@@ -400,7 +400,7 @@ fn a_coarser_slot_weighs_its_old_slots_by_their_records() {
 /// A cut that learns visibility and rebuilds from any data.
 fn learning_visibility() -> CutConfig {
     CutConfig {
-        min_splats: 0,
+        min_records: 0,
         visibility: true,
         ..CutConfig::default()
     }

@@ -36,7 +36,7 @@ pub enum Modulation {
     /// The learned quantity is a per-cluster correction factor on top of
     /// the analytic importance (`crate::light_sampler::importance`): at
     /// refinement each slot's learned weight is divided by its cluster's
-    /// importance at the cell's anchor (the mean position of the splats it
+    /// importance at the cell's anchor (the mean position of the records it
     /// learned from), and at a query point `x` the two children of a cut
     /// node are chosen in proportion to factor x importance at `x`:
     ///
@@ -50,11 +50,11 @@ pub enum Modulation {
     /// distance and orientation change across the cell, which the paper's
     /// constant distribution cannot. The factor keeps what the analytic
     /// bound misses (visibility, the BSDF). Where both importances at `x`
-    /// are zero the step falls back to `r`. Splats must carry their
+    /// are zero the step falls back to `r`. Records must carry their
     /// position for the anchor ([`crate::glt::Glt`] and the combined field
-    /// do, [`crate::cut::CutRules::splat_from`] does); a cut rebuilt
-    /// without one (splatted only through
-    /// [`crate::cut::CutRules::splat`]) keeps plain learned
+    /// do, [`crate::cut::CutRules::record_from`] does); a cut rebuilt
+    /// without one (recorded only through
+    /// [`crate::cut::CutRules::record`]) keeps plain learned
     /// probabilities. The initial cut has equal factors: it samples by the
     /// importance at the shading point until it has learned. The default.
     #[default]
@@ -84,7 +84,7 @@ pub enum Prior {
 /// between its two new children (they have no statistics of their own yet).
 ///
 /// Either way a child whose subtree has zero power gets nothing: its
-/// emitters can never receive a splat, and giving it weight would only lead
+/// emitters can never receive a record, and giving it weight would only lead
 /// the cut into lights that cannot be sampled below it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum SplitPrior {
@@ -120,7 +120,7 @@ pub struct CutConfig {
     /// distribution loses at most a factor `1 / (1 - alpha)` in variance.
     ///
     /// Default 0.2: cells learn from few samples, so clusters that matter
-    /// but drew no splat must be caught by the floor, and 0.2 costs at most
+    /// but drew no record must be caught by the floor, and 0.2 costs at most
     /// 1.25x against a perfect guide (measured in docs/experiments/settings.md,
     /// "Defaults of the cut"). 0 gives the paper's behaviour (biased for
     /// delta lights the cut never learned).
@@ -138,7 +138,7 @@ pub struct CutConfig {
     pub split_prior: SplitPrior,
     /// The scene's unbounded lights (distant and infinite, beside the
     /// emitters) and their prior probability `q` together. Each one's
-    /// learned share is its fraction of the splatted values in the cell,
+    /// learned share is its fraction of the recorded values in the cell,
     /// mixed with its prior share `q / count` by `alpha` like the emitters,
     /// so `alpha * q / count` is its floor. Default
     /// [`UnboundedLights::NONE`].
@@ -147,21 +147,21 @@ pub struct CutConfig {
     /// [`Accumulation::Deterministic`] gives bit-identical learned cuts
     /// whatever the thread count (48 bytes per sum instead of 8).
     pub accumulation: Accumulation,
-    /// The fewest non-zero splats a cut rebuilds from. Below it,
+    /// The fewest non-zero records a cut rebuilds from. Below it,
     /// `CutRules::refine` keeps the cut as
     /// it is and lets its sums go on accumulating into the next iteration:
-    /// a light splat is an unbiased estimate whatever distribution drew it,
+    /// a light record is an unbiased estimate whatever distribution drew it,
     /// so sums from several iterations add up. Without this floor a cell
-    /// that drew a handful of splats (cells of the combined field split on
-    /// radiance records, not light splats) rebuilds its cut around those
+    /// that drew a handful of records (cells of the combined field split on
+    /// radiance records, not light records) rebuilds its cut around those
     /// few lights, and only `alpha` stands between it and the rest.
     /// `0` gives the paper's rule (rebuild from any data). Default 64,
     /// measured (docs/experiments/settings.md, "The cut's data floor").
-    pub min_splats: u32,
+    pub min_records: u32,
     /// Learn each cut cluster's visibility: the fraction of its unshadowed
     /// contribution that arrives, from next-event records that carry both
-    /// (`splat_visibility` of [`crate::glt::Glt`], its vertex, the field and
-    /// `CutRules::splat_visibility`),
+    /// (`record_visibility` of [`crate::glt::Glt`], its vertex, the field and
+    /// `CutRules::record_visibility`),
     /// shrunk towards what the cluster had before when it has few records
     /// and never below 1/64. It is the factor resampled light choice puts
     /// on its target ([`crate::LightSampler::visibility`],
@@ -182,7 +182,7 @@ impl Default for CutConfig {
             split_prior: SplitPrior::Half,
             unbounded: UnboundedLights::NONE,
             accumulation: Accumulation::Fast,
-            min_splats: 64,
+            min_records: 64,
             visibility: false,
         }
     }
@@ -248,7 +248,7 @@ mod tests {
         let mine = CutConfig {
             sigma: 0.3,
             alpha: 0.4,
-            min_splats: 7,
+            min_records: 7,
             visibility: true,
             split_prior: SplitPrior::Power,
             ..CutConfig::default()
@@ -263,7 +263,7 @@ mod tests {
         assert_eq!(back, mine, "the importance rules are the default's");
         assert!(back.uses_importance());
         assert_eq!(
-            (back.sigma, back.alpha, back.min_splats, back.visibility),
+            (back.sigma, back.alpha, back.min_records, back.visibility),
             (0.3, 0.4, 7, true)
         );
         assert_eq!(back.split_prior, SplitPrior::Power);

@@ -11,13 +11,13 @@ use crate::error::ConfigError;
 use crate::light_tree::{InstancedLightTree, LightHierarchy, same_shape};
 use crate::math::Descent;
 
-/// The rules every cell's cut is sampled, splatted and refined by, with the
+/// The rules every cell's cut is sampled, recorded and refined by, with the
 /// light-tree tables they read: the hierarchy, each inner node's power
 /// split precomputed (4 bytes per node), the tree re-laid out for sampling
 /// walks (8 bytes per node, see `src/cut/walk.rs`), the decoded importance
 /// table when a rule uses importance (32 bytes per node), and the cut
 /// configuration. One per scene; every cell's [`GuidingCut`] is sampled
-/// ([`CutRules::sample`]), splatted ([`CutRules::splat`]) and refined
+/// ([`CutRules::sample`]), recorded ([`CutRules::record`]) and refined
 /// ([`CutRules::refine`]) through it. Over an
 /// [`InstancedLightTree`] the tables are its top tree's and one set per
 /// mesh, shared by the mesh's instances (`src/cut/instanced_tables.rs`).
@@ -82,11 +82,11 @@ pub(crate) fn decode_split(s: f32) -> Option<(f64, f64)> {
 }
 
 impl<H: LightHierarchy> CutRules<H> {
-    /// Prepares `tree` for guiding with `config`. O(nodes). Errors for an
+    /// Prepares `light_tree` for guiding with `config`. O(nodes). Errors for an
     /// invalid configuration ([`CutConfig::validate`]).
-    pub fn new(tree: H, config: CutConfig) -> Result<Self, ConfigError> {
+    pub fn new(light_tree: H, config: CutConfig) -> Result<Self, ConfigError> {
         config.validate()?;
-        Ok(Self::with_valid_config(tree, config))
+        Ok(Self::with_valid_config(light_tree, config))
     }
 
     /// [`CutRules::new`] for a `config` known to be valid.

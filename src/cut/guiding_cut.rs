@@ -25,7 +25,7 @@ use glam::Vec3;
 /// A cut is used through the [`CutRules`](super::CutRules) of its
 /// light tree: [`CutRules::new_cut`](super::CutRules::new_cut) makes
 /// one, [`CutRules::refine`](super::CutRules::refine) rebuilds the
-/// sampled copy from the sums and zeroes them. Sampling, pmf and splatting
+/// sampled copy from the sums and zeroes them. Sampling, pmf and recording
 /// take `&GuidingCut`; the sums take concurrent adds without locks.
 #[derive(Clone, Debug)]
 pub struct GuidingCut {
@@ -35,10 +35,10 @@ pub struct GuidingCut {
     /// cell collected (before the mixture with the prior); empty without
     /// unbounded lights.
     pub(super) unbounded: Box<[f32]>,
-    /// Non-zero splats recorded since the last rebuild (see
-    /// [`CutConfig::min_splats`]).
+    /// Non-zero records recorded since the last rebuild (see
+    /// [`CutConfig::min_records`]).
     pub(super) recorded: Counter,
-    /// Weighted sums of the positions splats came from (see `anchor_sums`),
+    /// Weighted sums of the positions records came from (see `anchor_sums`),
     /// since the last rebuild: the anchor of
     /// [`Modulation::Importance`](super::Modulation::Importance). Empty
     /// (no sums) without modulation.
@@ -231,7 +231,7 @@ impl GuidingCut {
         &self.unbounded
     }
 
-    /// What has been splatted since the last refinement: the emitters' total
+    /// What has been recorded since the last refinement: the emitters' total
     /// and the unbounded lights' total.
     pub fn accumulated(&self) -> (f64, f64) {
         let n = self.sums.len();
@@ -353,8 +353,8 @@ impl GuidingCut {
         &self.visibility
     }
 
-    /// Adds the position `p` a splat came from, with `weight` (its share
-    /// of the splat after filtering), to the anchor's sums. Non-finite
+    /// Adds the position `p` a record came from, with `weight` (its share
+    /// of the record after filtering), to the anchor's sums. Non-finite
     /// positions and cuts without anchor sums are ignored.
     #[inline]
     pub(crate) fn record_position(&self, p: Vec3, weight: f32) {
@@ -374,7 +374,7 @@ impl GuidingCut {
         self.anchor.add(6, weight);
     }
 
-    /// The mean position the splats since the last rebuild came from;
+    /// The mean position the records since the last rebuild came from;
     /// `None` when none carried a position.
     pub fn anchor(&self) -> Option<Vec3> {
         if self.anchor.is_empty() {

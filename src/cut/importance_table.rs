@@ -120,7 +120,7 @@ impl Entry {
     }
 }
 
-/// Every inner node's children decoded for [`ImportanceTable::importance`],
+/// Every inner node's children decoded for [`ImportanceTable::pair_importance`],
 /// indexed like the GLT's walk table.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ImportanceTable {
@@ -261,7 +261,7 @@ impl ImportanceTable {
     }
 }
 
-/// The importance of `e` at `q`: the bound of [`super::importance`] (power
+/// The importance of `e` at `q`: the bound of [`crate::light_sampler::importance()`] (power
 /// x conservative emission cosine / squared distance clamped to the
 /// bounding sphere, x the conservative `|cos|` to the normal), evaluated in
 /// `f32` up to the final quotient. Finite, never negative.

@@ -21,13 +21,13 @@
 //!   `Segment` a walk is in; `instanced_tables.rs`: those of an
 //!   [`crate::InstancedLightTree`], one set per mesh shared by its
 //!   instances;
-//! - `splat.rs`: recording direct-light estimates into a cut
-//!   ([`CutRules::splat`]);
+//! - `record.rs`: recording direct-light estimates into a cut
+//!   ([`CutRules::record`]);
 //! - `vertex.rs`: [`LightVertex`], a located cell's cut as a
 //!   [`crate::LightSampler`] with its records, for the GLT and the field;
 //! - `refine.rs`: rebuilding the cut from its sums ([`CutRules::refine`]);
 //! - `visibility.rs`: each cluster's learned visibility
-//!   ([`CutRules::splat_visibility`], [`CutConfig::visibility`]), the
+//!   ([`CutRules::record_visibility`], [`CutConfig::visibility`]), the
 //!   target factor of resampled light choice;
 //! - `importance_table.rs`: the light tree's nodes decoded for the
 //!   importance rules, sibling pairs in the walk's order;
@@ -60,9 +60,9 @@ mod importance_table;
 mod instanced_tables;
 mod octants;
 mod persist;
+mod record;
 mod refine;
 mod sampling;
-mod splat;
 mod tables;
 mod vertex;
 mod visibility;
@@ -72,7 +72,7 @@ pub use config::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
 pub use cut_node::{CutNode, Slot};
 pub use cut_rules::CutRules;
 pub use guiding_cut::{CutError, CutMemory, GuidingCut};
-pub(crate) use octants::OctantSplats;
+pub(crate) use octants::OctantRecords;
 pub(crate) use tables::TreeTables;
 // The f32 cone arithmetic of the decoded bounds, shared with the GPU
 // snapshot's importance (`src/snapshot/importance.rs`).

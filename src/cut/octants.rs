@@ -1,4 +1,4 @@
-//! [`OctantSplats`]: the splats a cell took, counted per octant, so that
+//! [`OctantRecords`]: the records a cell took, counted per octant, so that
 //! when the cell splits each half knows its share of the records its
 //! parent's cut learned from (the GLT's cells and the field's).
 
@@ -26,18 +26,18 @@ pub(crate) fn octant_of(p: Vec3, bounds: &Aabb) -> usize {
 /// against is a half that got nothing: a region not rendered yet.
 pub(crate) const TRUSTED_SHARE: f64 = 0.05;
 
-/// Splats since a cell's last refinement, per octant of the cell (index
+/// Records since a cell's last refinement, per octant of the cell (index
 /// as [`octant_of`]).
 #[derive(Clone, Debug, Default)]
-pub(crate) struct OctantSplats([Counter; 8]);
+pub(crate) struct OctantRecords([Counter; 8]);
 
-impl OctantSplats {
+impl OctantRecords {
     /// The given counts.
     pub(crate) fn with(counts: [u64; 8]) -> Self {
         Self(counts.map(Counter::with))
     }
 
-    /// `total` splats of unknown octants spread as evenly as counts can
+    /// `total` records of unknown octants spread as evenly as counts can
     /// be: each octant `total / 8`, the first `total % 8` one more (what
     /// saves of format versions 1 and 2, which kept one count per cell,
     /// load as).
@@ -47,7 +47,7 @@ impl OctantSplats {
         }))
     }
 
-    /// Counts a splat from `octant`.
+    /// Counts a record from `octant`.
     #[inline]
     pub(crate) fn count(&self, octant: usize) {
         self.0[octant & 7].bump();
@@ -113,7 +113,7 @@ impl OctantSplats {
         }
     }
 
-    /// Reads what [`OctantSplats::write`] wrote.
+    /// Reads what [`OctantRecords::write`] wrote.
     pub(crate) fn read(r: &mut Reader<'_>, field: &'static str) -> Result<Self, LoadError> {
         let mut counts = [0u64; 8];
         for n in &mut counts {
@@ -131,12 +131,12 @@ mod tests {
     /// nothing is lost or made up.
     #[test]
     fn a_total_spreads_evenly() {
-        assert_eq!(OctantSplats::spread(20).get(), [3, 3, 3, 3, 2, 2, 2, 2]);
-        assert_eq!(OctantSplats::spread(7).get(), [1, 1, 1, 1, 1, 1, 1, 0]);
-        assert_eq!(OctantSplats::spread(16).get(), [2; 8]);
-        assert_eq!(OctantSplats::spread(0).get(), [0; 8]);
+        assert_eq!(OctantRecords::spread(20).get(), [3, 3, 3, 3, 2, 2, 2, 2]);
+        assert_eq!(OctantRecords::spread(7).get(), [1, 1, 1, 1, 1, 1, 1, 0]);
+        assert_eq!(OctantRecords::spread(16).get(), [2; 8]);
+        assert_eq!(OctantRecords::spread(0).get(), [0; 8]);
         for total in [1u64, 9, 1001, u64::MAX] {
-            let counts = OctantSplats::spread(total).get();
+            let counts = OctantRecords::spread(total).get();
             assert_eq!(
                 counts.iter().map(|&c| c as u128).sum::<u128>(),
                 total as u128

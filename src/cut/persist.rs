@@ -33,7 +33,7 @@ impl CutConfig {
         w.u32(self.unbounded.count);
         w.f64(self.unbounded.probability);
         w.u8(tag(&ACCUMULATION, self.accumulation));
-        w.u32(self.min_splats);
+        w.u32(self.min_records);
         w.bool(self.visibility);
     }
 
@@ -63,7 +63,7 @@ impl CutConfig {
                 probability: r.f64("cut config: unbounded probability")?,
             },
             accumulation: untag(r, "cut config: accumulation", &ACCUMULATION)?,
-            min_splats: r.u32("cut config: min_splats")?,
+            min_records: r.u32("cut config: min_records")?,
             // Version 1 had no learned visibility.
             visibility: r.version() >= 2 && r.bool("cut config: visibility")?,
         };

@@ -36,8 +36,8 @@ impl<H: LightHierarchy> CutRules<H> {
     /// Rebuilds `cut`'s sampled copy from the accumulated sums, then zeroes them
     /// (swapping the two copies). Returns false when the cell collected
     /// nothing from emitters: then the cut is kept as it was. A cut that
-    /// recorded fewer than [`CutConfig::min_splats`](super::CutConfig::min_splats)
-    /// non-zero splats since its last rebuild is left entirely alone, sums
+    /// recorded fewer than [`CutConfig::min_records`](super::CutConfig::min_records)
+    /// non-zero records since its last rebuild is left entirely alone, sums
     /// included, to go on accumulating (also false).
     ///
     /// Top-down from the root with the cell's total `T`: a slot whose weight
@@ -136,10 +136,10 @@ impl<H: LightHierarchy> CutRules<H> {
     }
 
     /// What a refinement of `cut` starts from; `None` when the cut keeps
-    /// accumulating ([`CutConfig::min_splats`](super::CutConfig::min_splats)).
+    /// accumulating ([`CutConfig::min_records`](super::CutConfig::min_records)).
     fn plan(&self, cut: &GuidingCut) -> Option<Plan> {
         let config = self.config();
-        if cut.recorded.get() < u64::from(config.min_splats) {
+        if cut.recorded.get() < u64::from(config.min_records) {
             return None;
         }
         let clusters = cut.first_unbounded_sum();
@@ -377,11 +377,11 @@ mod tests {
                     let e = (k * 7 + round) % 40;
                     let l = LightId::Emitter(e);
                     let p = Vec3::new(e as f32, 0.0, 1.0);
-                    guide.splat_from(&cut, p, l, 1.0 + (e * e) as f32);
-                    guide.splat_visibility(&cut, l, (e % 3) as f32 / 2.0, 1.0);
+                    guide.record_from(&cut, p, l, 1.0 + (e * e) as f32);
+                    guide.record_visibility(&cut, l, (e % 3) as f32 / 2.0, 1.0);
                 }
                 if config.unbounded.count > 0 {
-                    guide.splat(&cut, LightId::Unbounded(1), 50.0);
+                    guide.record(&cut, LightId::Unbounded(1), 50.0);
                 }
                 let g = guide.growth(&cut);
                 assert!(guide.refine(&mut cut), "round {round}");
@@ -414,7 +414,7 @@ mod tests {
             let trained = guide.new_cut();
             for k in 0..6000u32 {
                 let e = (k * 13) % 64;
-                guide.splat(&trained, LightId::Emitter(e), 1.0 + ((e * 7) % 11) as f32);
+                guide.record(&trained, LightId::Emitter(e), 1.0 + ((e * 7) % 11) as f32);
             }
             let refined_at = |sigma: f64| {
                 let rules = CutRules::new(&tree, CutConfig { sigma, ..config }).unwrap();
@@ -545,13 +545,13 @@ mod tests {
         let guide = CutRules::new(&tree, config).unwrap();
         let mut cut = guide.new_cut();
         for k in 0..4000u32 {
-            guide.splat(&cut, LightId::Emitter(k % 16), 1.0 + (k % 16) as f32);
+            guide.record(&cut, LightId::Emitter(k % 16), 1.0 + (k % 16) as f32);
         }
         assert!(guide.refine(&mut cut));
         let nodes = cut.nodes.len();
         assert!(nodes > 2, "{nodes}");
         for _ in 0..4000 {
-            guide.splat(&cut, LightId::Unbounded(0), 1.0);
+            guide.record(&cut, LightId::Unbounded(0), 1.0);
         }
         let g = guide.growth(&cut);
         assert!(!guide.refine(&mut cut));
@@ -583,7 +583,7 @@ mod tests {
         // gives it nothing); the second finds it holding records.
         for round in 0..2 {
             for k in 0..4000u32 {
-                let outcome = guide.splat(&cut, LightId::Emitter(k % 4), 1.0);
+                let outcome = guide.record(&cut, LightId::Emitter(k % 4), 1.0);
                 let dark = k % 4 >= 2;
                 assert_eq!(outcome == RecordOutcome::Dropped, dark, "light {}", k % 4);
             }

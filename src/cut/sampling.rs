@@ -266,7 +266,7 @@ fn pick((pl, pr): (f64, f64), side: Side) -> f64 {
     }
 }
 
-/// Everything one query needs: the guiding tree, the cell's cut nodes, the
+/// Everything one query needs: the cut rules, the cell's cut nodes, the
 /// rule below the cut and the shading point.
 struct Rule<'b, H: LightHierarchy, R: Restriction> {
     guide: &'b CutRules<H>,

@@ -1,10 +1,10 @@
 //! [`LightVertex`]: a located cell's learned light choice, the one
-//! cut-based [`LightSampler`], serving every light query and record at a
+//! cut-based [`LightChoice`], serving every light query and record at a
 //! path vertex for the GLT and the guiding field alike.
 
 use super::cut_rules::CutRules;
 use super::guiding_cut::GuidingCut;
-use super::octants::{OctantSplats, octant_of};
+use super::octants::{OctantRecords, octant_of};
 use crate::dropped::{DropCounters, DropReason};
 use crate::light_sampler::ShadingContext;
 use crate::light_sampler::{LightChoice, LightId, LightSample};
@@ -130,7 +130,7 @@ impl<'a, H: LightHierarchy> LightVertex<'a, H> {
             Some((cells, at)) => cells.record_light((self.ctx.position, at), light, value),
             None => self
                 .rules
-                .splat_from(self.cut, self.ctx.position, light, value),
+                .record_from(self.cut, self.ctx.position, light, value),
         }
     }
 
@@ -151,7 +151,7 @@ impl<'a, H: LightHierarchy> LightVertex<'a, H> {
     ) -> RecordOutcome {
         let outcome = self
             .rules
-            .splat_visibility(self.cut, light, shadowed, unshadowed);
+            .record_visibility(self.cut, light, shadowed, unshadowed);
         if outcome == RecordOutcome::Dropped {
             if let Some((cells, _)) = self.cells {
                 cells.dropped().count(DropReason::Light);
@@ -183,7 +183,7 @@ impl<H: LightHierarchy> CutRules<H> {
     /// in. A [`RecordOutcome::Dropped`] result is counted once. Shared by
     /// [`Glt`](crate::glt::Glt) and the guiding field.
     #[inline]
-    pub(crate) fn record_in_cells<C: AsRef<GuidingCut> + AsRef<OctantSplats>>(
+    pub(crate) fn record_in_cells<C: AsRef<GuidingCut> + AsRef<OctantRecords>>(
         &self,
         (cells, filter, dropped): Cells<'_, C>,
         (p, at): Located,
@@ -196,10 +196,10 @@ impl<H: LightHierarchy> CutRules<H> {
         cells.spread_from(p, at, filter, jitter, |cell, weight| {
             let cell = cells.data(cell);
             let cut: &GuidingCut = cell.as_ref();
-            match self.splat_weighted_from(cut, p, weight, light, value * weight) {
+            match self.record_weighted_from(cut, p, weight, light, value * weight) {
                 RecordOutcome::Dropped => outcome = RecordOutcome::Dropped,
                 o => {
-                    AsRef::<OctantSplats>::as_ref(cell).count(octant);
+                    AsRef::<OctantRecords>::as_ref(cell).count(octant);
                     if o == RecordOutcome::Recorded && outcome != RecordOutcome::Dropped {
                         outcome = o;
                     }

@@ -5,7 +5,7 @@
 //!
 //! A next-event record carries the value the renderer records for the
 //! light (0 when the shadow ray was blocked) and the value it would have
-//! recorded unoccluded ([`CutRules::splat_visibility`]); per slot the cut
+//! recorded unoccluded ([`CutRules::record_visibility`]); per slot the cut
 //! sums both. At a rebuild each old slot's estimate is
 //!
 //! ```text
@@ -19,11 +19,11 @@
 //! slot takes the estimate of the old slot that covered its light node or,
 //! where the new cut is coarser, the unshadowed-weighted mean of the old
 //! slots below it. The sums are zeroed at each rebuild; the estimates carry
-//! over, and a cut that is not rebuilt ([`CutConfig::min_splats`]) goes on
+//! over, and a cut that is not rebuilt ([`CutConfig::min_records`]) goes on
 //! accumulating.
 //!
 //! [`CutConfig::visibility`]: super::CutConfig::visibility
-//! [`CutConfig::min_splats`]: super::CutConfig::min_splats
+//! [`CutConfig::min_records`]: super::CutConfig::min_records
 
 use super::cut_node::{CutNode, Slot};
 use super::cut_rules::CutRules;
@@ -41,14 +41,14 @@ impl<H: LightHierarchy> CutRules<H> {
     /// learned visibility: `shadowed` is the value recorded for it (0 when
     /// the shadow ray was blocked), `unshadowed` the value it would have
     /// been without occluders (the same scalar as
-    /// [`CutRules::splat`]'s). A sample the renderer skipped (a zero
+    /// [`CutRules::record`]'s). A sample the renderer skipped (a zero
     /// BSDF, say) is not a record. [`RecordOutcome::Ignored`] when the
     /// configuration learns no visibility (then nothing else is looked at
     /// but the values), [`RecordOutcome::Zero`] when `unshadowed` is 0; [`RecordOutcome::Dropped`] for
     /// values that are negative, not finite, or with `shadowed >
     /// unshadowed`, and, while learning, lights out of range. `&self`:
     /// any number of threads at once.
-    pub fn splat_visibility(
+    pub fn record_visibility(
         &self,
         cut: &GuidingCut,
         light: LightId,
@@ -256,7 +256,7 @@ mod tests {
         let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
         let k = 3;
         let config = CutConfig {
-            min_splats: 0,
+            min_records: 0,
             visibility: true,
             unbounded: UnboundedLights::new(k, 0.1).unwrap(),
             ..CutConfig::default()
@@ -266,10 +266,10 @@ mod tests {
         for round in 0..3 {
             for e in 0..40u32 {
                 let l = LightId::Emitter(e);
-                guide.splat(&cut, l, 1.0 + e as f32);
-                guide.splat_visibility(&cut, l, (e % 2) as f32, 1.0);
+                guide.record(&cut, l, 1.0 + e as f32);
+                guide.record_visibility(&cut, l, (e % 2) as f32, 1.0);
             }
-            guide.splat_visibility(&cut, LightId::Unbounded(2), 0.5, 1.0);
+            guide.record_visibility(&cut, LightId::Unbounded(2), 0.5, 1.0);
             guide.refine(&mut cut);
             let slots = visibility_slots(cut.nodes.len(), &config);
             assert_eq!(cut.visibility.len(), slots, "round {round}");

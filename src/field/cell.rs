@@ -1,20 +1,20 @@
 //! What one cell of the guiding field holds.
 
-use crate::cut::{GuidingCut, OctantSplats};
+use crate::cut::{GuidingCut, OctantRecords};
 use crate::sd_tree::SdCell;
 
 /// One cell of a [`GuidingField`](super::GuidingField): an SD-tree cell
 /// (directional quadtree, statistical weight, BSDF sampling fraction) and a
 /// guiding cut. A spatial split gives both children a copy of both, each
-/// cut trusted as far as the light splats it learned from fell in that
+/// cut trusted as far as the light records it learned from fell in that
 /// child ([`GuidingCut::confidence`]).
 #[derive(Clone, Debug)]
 pub struct FieldCell {
     pub(super) sd: SdCell,
     pub(super) cut: GuidingCut,
-    /// Light splats since the last refinement per octant of the cell (as
+    /// Light records since the last refinement per octant of the cell (as
     /// [`GltCell`](crate::glt::GltCell) counts them).
-    pub(super) octants: OctantSplats,
+    pub(super) octants: OctantRecords,
 }
 
 impl FieldCell {
@@ -30,22 +30,22 @@ impl FieldCell {
         &self.cut
     }
 
-    /// A cell with `sd` and `cut`, no light splat counted.
+    /// A cell with `sd` and `cut`, no light record counted.
     pub(super) fn new(sd: SdCell, cut: GuidingCut) -> Self {
-        Self::with_counts(sd, cut, OctantSplats::default())
+        Self::with_counts(sd, cut, OctantRecords::default())
     }
 
-    /// A cell with `sd`, `cut` and the light splats counted per octant.
-    pub(super) fn with_counts(sd: SdCell, cut: GuidingCut, octants: OctantSplats) -> Self {
+    /// A cell with `sd`, `cut` and the light records counted per octant.
+    pub(super) fn with_counts(sd: SdCell, cut: GuidingCut, octants: OctantRecords) -> Self {
         Self { sd, cut, octants }
     }
 
-    /// Light splats since the last refinement, per octant of the cell.
-    pub fn octant_splats(&self) -> [u64; 8] {
+    /// Light records since the last refinement, per octant of the cell.
+    pub fn octant_records(&self) -> [u64; 8] {
         self.octants.get()
     }
 
-    /// Splits the light splats' counts between this cell (the lower half
+    /// Splits the light records' counts between this cell (the lower half
     /// along `axis`) and `upper`, a copy of it, scaling each cut's
     /// confidence by its half's share.
     pub(super) fn share_split(&mut self, upper: &mut Self, axis: usize) {
@@ -84,9 +84,9 @@ impl AsRef<GuidingCut> for FieldCell {
     }
 }
 
-impl AsRef<OctantSplats> for FieldCell {
+impl AsRef<OctantRecords> for FieldCell {
     #[inline]
-    fn as_ref(&self) -> &OctantSplats {
+    fn as_ref(&self) -> &OctantRecords {
         &self.octants
     }
 }

@@ -65,9 +65,14 @@ impl<H: LightHierarchy> GuidingField<H> {
     /// Bytes used, per structure.
     pub fn memory(&self) -> FieldMemory {
         FieldMemory {
-            sd: SdTreeMemory::of(&self.cells),
-            cuts: self.cells.data_slice().iter().map(|c| c.cut.memory()).sum(),
-            shared_bytes: self.guide.bytes(),
+            sd: SdTreeMemory::of(&self.spatial),
+            cuts: self
+                .spatial
+                .data_slice()
+                .iter()
+                .map(|c| c.cut.memory())
+                .sum(),
+            shared_bytes: self.rules.bytes(),
         }
     }
 }

@@ -1,7 +1,7 @@
 //! The guiding field the paper uses: one spatial tree whose cells each hold
 //! an SD-tree cell (directional quadtree, statistical weight, BSDF sampling
 //! fraction) and a Guiding Light Tree cut, so that one lookup per path
-//! vertex serves directional guiding, NEE guiding and both splats.
+//! vertex serves directional guiding, NEE guiding and both records.
 //!
 //! A renderer, at each path vertex `x`:
 //! 1. looks the cell up once: [`GuidingField::vertex`] gives a
@@ -12,16 +12,16 @@
 //!    ([`DirectionVertex::sample_direction`]), and weighs with
 //!    [`DirectionVertex::mixture_pdf`];
 //! 3. chooses a light for next-event estimation from the cell's cut: the
-//!    light part is a [`LightSampler`](crate::LightSampler) (`sample` /
-//!    `pmf`);
+//!    light part is a [`LightChoice`](crate::LightChoice) (`sample(u)` /
+//!    `pmf(light)`, the context given once at the lookup);
 //! 4. records the direct-light estimate for the light it connected to
 //!    ([`LightVertex::record_light`], the GLT's record) and, once the path
 //!    is done, the incident radiance along the sampled direction
 //!    ([`DirectionVertex::record_radiance`], PPG's record), optionally the
 //!    fraction sample ([`DirectionVertex::record_fraction`]).
 //!
-//! The two parts are the same types an [`SdTree`](crate::sd_tree::SdTree)
-//! and a [`Glt`](crate::glt::Glt) give, so one integrator serves all three.
+//! The two parts are the same types an [`SdTree`](crate::SdTree)
+//! and a [`Glt`](crate::Glt) give, so one integrator serves all three.
 //! Queries and records take `&self` from any number of threads;
 //! [`GuidingField::refine`] takes `&mut self` between iterations.
 //!
@@ -34,14 +34,14 @@
 //!
 //! ## Semantics: the SD-tree's and the GLT's, shared
 //!
-//! Nothing here re-implements either structure: radiance splats, fraction
+//! Nothing here re-implements either structure: radiance records, fraction
 //! records, the per-cell SD refinement, the spatial filters, the split rule
 //! and the dropped-input counting are the SD-tree's own functions run over
-//! this field's cells, and light splats, cut sampling and cut refinement
+//! this field's cells, and light records, cut sampling and cut refinement
 //! are the [`CutRules`]'s. So, fed the same records (and random
 //! numbers), the field's spatial tree and quadtrees equal those of an
-//! [`SdTree`](crate::sd_tree::SdTree) with the same configuration bit for
-//! bit, and each cell's cut equals a cut fed the light splats that landed
+//! [`SdTree`](crate::SdTree) with the same configuration bit for
+//! bit, and each cell's cut equals a cut fed the light records that landed
 //! in that cell (tested in `tests/field.rs`).
 //!
 //! ## Refinement
@@ -49,11 +49,11 @@
 //! [`GuidingField::refine`] ends an iteration: per cell, the SD-tree's step
 //! (learned fraction, quadtree rebuilt and refined, weight kept for the
 //! split rule) and the cut's rebuild from its sums; then PPG's spatial rule
-//! splits every cell whose radiance-splat weight exceeds `c * sqrt(2^k)`,
+//! splits every cell whose radiance-record weight exceeds `c * sqrt(2^k)`,
 //! giving both children a copy of the quadtree *and* the cut (the paper:
 //! "If a spatial cell is subdivided by the PPG refinement we copy its cut
-//! to both children"). Light splats do not drive spatial splits: in the
-//! paper every path vertex makes a radiance splat, so the SD weight already
+//! to both children"). Light records do not drive spatial splits: in the
+//! paper every path vertex makes a radiance record, so the SD weight already
 //! counts the vertices. Refining the payloads before splitting gives the
 //! same children as splitting first (they would refine identical copies)
 //! with less work.
@@ -99,11 +99,22 @@
 //! assert_eq!(pdf, d.direction_pdf(dir));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+//!
+//! The same files as `glt/` and `sd_tree/`:
+//! - `mod.rs`: [`GuidingField`], its construction and what it hands out;
+//! - `config.rs`: [`FieldConfig`];
+//! - `cell.rs`: [`FieldCell`], an SD-tree cell and a cut;
+//! - `vertex.rs`: the one lookup per path vertex ([`FieldVertex`]) and
+//!   where its two kinds of records go;
+//! - `refine.rs`: both refinements in one pass over the cells;
+//! - `persist.rs`: saving, loading and merging a field;
+//! - `memory.rs`: [`FieldMemory`].
 
 mod cell;
 mod config;
 mod memory;
 mod persist;
+mod refine;
 mod vertex;
 
 pub use cell::FieldCell;
@@ -118,8 +129,7 @@ use crate::light_tree::LightHierarchy;
 use crate::math::Aabb;
 use crate::sd_tree::SdState;
 use crate::snapshot::{Snapshot, SnapshotError};
-use crate::spatial::{BinaryTree, CellId, RefineOutcome, SpatialFilter, SpatialTree};
-use glam::Vec3;
+use crate::spatial::{BinaryTree, SpatialFilter, SpatialTree};
 
 /// The paper's guiding field: one spatial tree whose cells hold an SD-tree
 /// cell and a guiding cut. See the module docs.
@@ -129,80 +139,45 @@ use glam::Vec3;
 /// (`GuidingField<Arc<LightTree>>`) or borrowed (`GuidingField<&LightTree>`).
 #[derive(Clone, Debug)]
 pub struct GuidingField<H: LightHierarchy> {
-    cells: BinaryTree<FieldCell>,
+    spatial: BinaryTree<FieldCell>,
     /// The SD-tree's configuration, iteration count and drop counters.
     sd: SdState,
-    guide: CutRules<H>,
+    rules: CutRules<H>,
     light_filter: SpatialFilter,
 }
 
 impl<H: LightHierarchy> GuidingField<H> {
-    /// A field over the light hierarchy `lights` for shading points inside
+    /// A field over the light hierarchy `light_tree` for shading points inside
     /// `scene` (the scene's geometry bounds; points outside are clamped
     /// onto the spatial tree's cube): one cell, with a uniform quadtree and
     /// the initial (power prior) cut. Errors for empty or non-finite
     /// bounds, and for an invalid configuration
     /// ([`FieldConfig::validate`]).
-    pub fn new(lights: H, scene: Aabb, config: FieldConfig) -> Result<Self, Error> {
+    pub fn new(light_tree: H, scene: Aabb, config: FieldConfig) -> Result<Self, Error> {
         config.validate()?;
-        let guide = CutRules::new(lights, config.cut)?;
+        let rules = CutRules::new(light_tree, config.cut)?;
         let sd = SdState::new(config.sd);
-        let cell = FieldCell::new(sd.new_cell(), guide.new_cut());
+        let cell = FieldCell::new(sd.new_cell(), rules.new_cut());
         Ok(Self {
-            cells: BinaryTree::new(scene, cell)?,
+            spatial: BinaryTree::new(scene, cell)?,
             sd,
-            guide,
+            rules,
             light_filter: config.light_filter,
         })
-    }
-
-    /// The cell holding `p`, `None` for a non-finite point.
-    #[inline]
-    pub fn locate(&self, p: Vec3) -> Option<CellId> {
-        self.cells.locate(p)
-    }
-
-    /// Ends iteration `k = self.iteration()`: per cell, the SD-tree's step
-    /// (fraction, quadtree) and the cut's rebuild from its sums (a cut that
-    /// collected nothing is kept), then PPG's spatial rule: cells whose
-    /// radiance-splat weight exceeds `c * sqrt(2^k)` split, recursively,
-    /// within [`SdTreeConfig::max_bytes`](crate::sd_tree::SdTreeConfig::max_bytes)
-    /// (counted as `FieldMemory::capped`), both children holding copies
-    /// of the quadtree, the weight halved, and the cut. Collected sums are
-    /// zeroed. Returns what the spatial pass did.
-    pub fn refine(&mut self) -> RefineOutcome {
-        let guide = &self.guide;
-        let outcome = self.sd.refine(
-            &mut self.cells,
-            |cell| guide.growth(&cell.cut),
-            |cell, scale| {
-                let cap = scale.and_then(|_| guide.growth(&cell.cut).cap(scale));
-                if guide.refine_within(&mut cell.cut, cap) {
-                    // Learned from the cell's own light splats.
-                    cell.cut.confidence = 1.0;
-                }
-            },
-            FieldCell::share_split,
-            FieldCell::heap_bytes,
-        );
-        for cell in self.cells.data_slice_mut() {
-            cell.octants.reset();
-        }
-        outcome
     }
 
     /// The configuration.
     pub fn config(&self) -> FieldConfig {
         FieldConfig {
             sd: self.sd.config,
-            cut: *self.guide.config(),
+            cut: *self.rules.config(),
             light_filter: self.light_filter,
         }
     }
 
     /// The light hierarchy.
     pub fn light_tree(&self) -> &H {
-        self.guide.light_tree()
+        self.rules.light_tree()
     }
 
     /// Hands the field its light tree after a refit and returns the one it
@@ -210,9 +185,9 @@ impl<H: LightHierarchy> GuidingField<H> {
     /// [`Glt::set_light_tree`](crate::Glt::set_light_tree) does (the
     /// directional quadtrees are untouched). [`Error::LightTreeShape`] for
     /// a tree of another shape, and nothing changes.
-    pub fn set_light_tree(&mut self, lights: H) -> Result<H, Error> {
-        self.guide
-            .set_light_tree(lights)
+    pub fn set_light_tree(&mut self, light_tree: H) -> Result<H, Error> {
+        self.rules
+            .set_light_tree(light_tree)
             .map_err(|_| Error::LightTreeShape)
     }
 
@@ -221,17 +196,18 @@ impl<H: LightHierarchy> GuidingField<H> {
     /// [`Glt::snapshot`](crate::Glt::snapshot)); the directional half
     /// (the SD-trees) is not in it.
     pub fn snapshot(&self) -> Result<Snapshot, SnapshotError> {
-        Snapshot::new(&self.guide, &self.cells)
+        Snapshot::new(&self.rules, &self.spatial)
     }
 
-    /// The guiding tree every cell's cut is used through.
+    /// The rules every cell's cut is sampled, recorded and refined by (the
+    /// light tree, its tables and the [`CutConfig`](crate::CutConfig)).
     pub fn cut_rules(&self) -> &CutRules<H> {
-        &self.guide
+        &self.rules
     }
 
     /// The spatial tree and its cells.
     pub fn spatial(&self) -> &BinaryTree<FieldCell> {
-        &self.cells
+        &self.spatial
     }
 
     /// How many refinements were made (the `k` of the next split threshold).
@@ -241,13 +217,13 @@ impl<H: LightHierarchy> GuidingField<H> {
 
     /// Number of spatial cells.
     pub fn cell_count(&self) -> usize {
-        self.cells.cell_count()
+        self.spatial.cell_count()
     }
 
-    /// Splats and fraction records dropped for bad input so far, per
-    /// reason: radiance splats and fraction records as
+    /// Radiance and fraction records dropped for bad input so far, per
+    /// reason: radiance records and fraction records as
     /// [`SdTree::dropped_records`](crate::sd_tree::SdTree::dropped_records)
-    /// counts them, light splats in [`DroppedRecords::light`] (as
+    /// counts them, light records in [`DroppedRecords::light`] (as
     /// [`Glt::dropped_records`](crate::glt::Glt::dropped_records)).
     pub fn dropped_records(&self) -> DroppedRecords {
         self.sd.dropped.snapshot()

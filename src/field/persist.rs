@@ -2,7 +2,7 @@
 //! statistics.
 
 use super::{FieldCell, GuidingField};
-use crate::cut::{CutConfig, CutRules, GuidingCut, OctantSplats};
+use crate::cut::{CutConfig, CutRules, GuidingCut, OctantRecords};
 use crate::light_tree::LightHierarchy;
 use crate::light_tree::{fingerprint, read_fingerprint, shape_fingerprint};
 use crate::persist::{Kind, LoadError, Reader, Writer, tag, untag};
@@ -19,12 +19,12 @@ impl<H: LightHierarchy> GuidingField<H> {
         let mut w = Writer::default();
         w.u64(shape_fingerprint(self.light_tree()));
         self.sd.write(&mut w);
-        self.guide.config().write(&mut w);
+        self.rules.config().write(&mut w);
         w.u8(tag(&FILTERS, self.light_filter));
-        self.cells.write(&mut w, |cell, w| {
+        self.spatial.write(&mut w, |cell, w| {
             cell.sd.write(w);
             cell.cut.write(w);
-            // Version 3: the light splats per octant.
+            // Version 3: the light records per octant.
             cell.octants.write(w);
         });
         w.finish(Kind::Field)
@@ -35,28 +35,28 @@ impl<H: LightHierarchy> GuidingField<H> {
     /// [`Glt::from_bytes`](crate::Glt::from_bytes))
     /// ([`LoadError::LightTreeMismatch`] otherwise); checked, and then
     /// exactly like the one saved.
-    pub fn from_bytes(bytes: &[u8], lights: H) -> Result<Self, LoadError> {
+    pub fn from_bytes(bytes: &[u8], light_tree: H) -> Result<Self, LoadError> {
         let mut r = Reader::open(bytes, Kind::Field)?;
-        read_fingerprint(&mut r, &lights)?;
+        read_fingerprint(&mut r, &light_tree)?;
         let sd = SdState::read(&mut r)?;
         let at = r.offset();
         let config = CutConfig::read(&mut r)?;
-        let guide = CutRules::new(lights, config).map_err(|e| e.at(at))?;
+        let rules = CutRules::new(light_tree, config).map_err(|e| e.at(at))?;
         let light_filter = untag(&mut r, "light filter", &FILTERS)?;
-        let cells = BinaryTree::read(&mut r, |r| {
+        let spatial = BinaryTree::read(&mut r, |r| {
             let sd_cell = SdCell::read(r, &sd.config)?;
-            let cut = GuidingCut::read(r, &guide)?;
+            let cut = GuidingCut::read(r, &rules)?;
             let octants = match r.version() {
-                3.. => OctantSplats::read(r, "cell: octant light splats")?,
-                _ => OctantSplats::default(),
+                3.. => OctantRecords::read(r, "cell: octant light records")?,
+                _ => OctantRecords::default(),
             };
             Ok(FieldCell::with_counts(sd_cell, cut, octants))
         })?;
         r.end()?;
         Ok(Self {
-            cells,
+            spatial,
             sd,
-            guide,
+            rules,
             light_filter,
         })
     }
@@ -65,7 +65,7 @@ impl<H: LightHierarchy> GuidingField<H> {
     /// was learned: the starting point of a worker's share (see
     /// [`GuidingField::merge`]).
     pub fn clear_records(&mut self) {
-        for cell in self.cells.data_slice_mut() {
+        for cell in self.spatial.data_slice_mut() {
             cell.sd.clear_records();
             cell.cut.clear_records();
             cell.octants.reset();
@@ -81,23 +81,23 @@ impl<H: LightHierarchy> GuidingField<H> {
     /// for bit.
     pub fn merge(&mut self, other: &Self) -> bool {
         let same = fingerprint(self.light_tree()) == fingerprint(other.light_tree())
-            && self.guide.config() == other.guide.config()
+            && self.rules.config() == other.rules.config()
             && self.light_filter == other.light_filter
-            && self.cells.same_layout(&other.cells)
+            && self.spatial.same_layout(&other.spatial)
             && self
-                .cells
+                .spatial
                 .data_slice()
                 .iter()
-                .zip(other.cells.data_slice())
+                .zip(other.spatial.data_slice())
                 .all(|(a, b)| a.sd.same_layout(&b.sd) && a.cut.same_layout(&b.cut));
         if !same || !self.sd.merge(&other.sd) {
             return false;
         }
         for (a, b) in self
-            .cells
+            .spatial
             .data_slice_mut()
             .iter_mut()
-            .zip(other.cells.data_slice())
+            .zip(other.spatial.data_slice())
         {
             a.sd.merge(&b.sd);
             a.cut.merge(&b.cut);

@@ -9,7 +9,7 @@ use crate::light_sampler::ShadingContext;
 use crate::light_tree::LightHierarchy;
 use crate::record::RecordOutcome;
 use crate::sd_tree::{DirectionVertex, RadianceCells};
-use crate::spatial::{Located, SpatialTree};
+use crate::spatial::{CellId, Located, SpatialTree};
 use glam::Vec3;
 
 /// A path vertex located in a [`GuidingField`] ([`GuidingField::vertex`]):
@@ -25,6 +25,12 @@ pub struct FieldVertex<'f, H: LightHierarchy> {
 }
 
 impl<H: LightHierarchy> GuidingField<H> {
+    /// The cell holding `p`, `None` for a non-finite point.
+    #[inline]
+    pub fn locate(&self, p: Vec3) -> Option<CellId> {
+        self.spatial.locate(p)
+    }
+
     /// The one lookup per path vertex: the cell holding `ctx.position`
     /// (clamped onto the root cube), through which all queries and records
     /// at that point go. `None` for a non-finite position (counted as a
@@ -32,14 +38,14 @@ impl<H: LightHierarchy> GuidingField<H> {
     #[inline]
     pub fn vertex(&self, ctx: &ShadingContext) -> Option<FieldVertex<'_, H>> {
         let p = ctx.position;
-        let Some(at) = self.cells.locate_with_bounds(p) else {
+        let Some(at) = self.spatial.locate_with_bounds(p) else {
             self.sd.dropped.count(DropReason::Position);
             return None;
         };
-        let cell: &FieldCell = self.cells.data(at.0);
+        let cell: &FieldCell = self.spatial.data(at.0);
         Some(FieldVertex {
             direction: DirectionVertex::new(&self.sd, &cell.sd, (p, at), self),
-            light: LightVertex::new(&self.guide, &cell.cut, ctx, at, self),
+            light: LightVertex::new(&self.rules, &cell.cut, ctx, at, self),
         })
     }
 }
@@ -47,15 +53,16 @@ impl<H: LightHierarchy> GuidingField<H> {
 impl<H: LightHierarchy> RadianceCells for GuidingField<H> {
     #[inline]
     fn record_radiance(&self, at: Located, dir: Vec3, radiance: f32, pdf: f32) -> RecordOutcome {
-        self.sd.record_radiance(&self.cells, at, dir, radiance, pdf)
+        self.sd
+            .record_radiance(&self.spatial, at, dir, radiance, pdf)
     }
 }
 
 impl<H: LightHierarchy> LightCells for GuidingField<H> {
     #[inline]
     fn record_light(&self, at: Located, light: LightId, value: f32) -> RecordOutcome {
-        let cells = (&self.cells, self.light_filter, &self.sd.dropped);
-        self.guide.record_in_cells(cells, at, light, value)
+        let cells = (&self.spatial, self.light_filter, &self.sd.dropped);
+        self.rules.record_in_cells(cells, at, light, value)
     }
 
     #[inline]

@@ -2,16 +2,16 @@
 //! refines, and what each half of it inherits when it splits.
 //!
 //! A cell refines on what it has seen itself, not on a global clock: it
-//! takes part in a refinement once it holds 3/2 of the splats that fell
+//! takes part in a refinement once it holds 3/2 of the records that fell
 //! in it before its last one (for a half born of a split, its own share of
-//! its parent's; any splat before its first), and its spatial split
+//! its parent's; any record before its first), and its spatial split
 //! threshold is `c sqrt(2^g)` with `g` its own refinement count. A
 //! renderer that refines after every pass of PPG's doubling schedule
-//! makes every cell take part every time (each pass doubles the splats),
+//! makes every cell take part every time (each pass doubles the records),
 //! which is PPG's rule; one that refines after every few tiles makes the
 //! cells the tiles reached refine and leaves the others accumulating.
 //!
-//! The splats are counted per octant of the cell, so when a cell splits
+//! The records are counted per octant of the cell, so when a cell splits
 //! each half knows its share of the records its parent learned from (for
 //! three levels: a split halves one axis and keeps the other two). A half
 //! with less than a twentieth of them trusts the inherited cut less
@@ -19,11 +19,11 @@
 //! never reached, until it refines on records of its own.
 
 use crate::cut::GuidingCut;
-use crate::cut::OctantSplats;
+use crate::cut::OctantRecords;
 use crate::spatial::split_threshold;
 
 /// A cell takes part in a refinement once it has collected
-/// `READY_NUM / READY_DEN` times the splats that fell in it before its last.
+/// `READY_NUM / READY_DEN` times the records that fell in it before its last.
 const READY_NUM: u64 = 3;
 const READY_DEN: u64 = 2;
 
@@ -32,11 +32,11 @@ const READY_DEN: u64 = 2;
 #[derive(Clone, Debug)]
 pub struct GltCell {
     pub(super) cut: GuidingCut,
-    /// Splats (zero values included) since the cell last took part in a
+    /// Records (zero values included) since the cell last took part in a
     /// refinement, per octant of the cell: bit 0 set for `x` at or above
     /// the cell's centre, bit 1 for `y`, bit 2 for `z`.
-    pub(super) octants: OctantSplats,
-    /// The splats that fell in the cell before its last refinement (its
+    pub(super) octants: OctantRecords,
+    /// The records that fell in the cell before its last refinement (its
     /// share of them, for a half born of a split; 0 before the first).
     pub(super) used: u64,
     /// Refinements it took part in (a half starts from its parent's).
@@ -50,7 +50,7 @@ pub struct GltCell {
 pub(super) struct Pass {
     /// Whether the cell takes part.
     pub(super) ready: bool,
-    /// The splats the split rule sees: the cell's, halved at each split
+    /// The records the split rule sees: the cell's, halved at each split
     /// (PPG's rule).
     pub(super) count: u64,
     /// The confidence its cut keeps from this pass's splits: the product
@@ -75,9 +75,9 @@ impl AsRef<GuidingCut> for GltCell {
     }
 }
 
-impl AsRef<OctantSplats> for GltCell {
+impl AsRef<OctantRecords> for GltCell {
     #[inline]
-    fn as_ref(&self) -> &OctantSplats {
+    fn as_ref(&self) -> &OctantRecords {
         &self.octants
     }
 }
@@ -85,13 +85,13 @@ impl AsRef<OctantSplats> for GltCell {
 impl GltCell {
     /// A cell with `cut`, nothing recorded.
     pub(super) fn new(cut: GuidingCut) -> Self {
-        Self::with_counts(cut, OctantSplats::default(), 0, 0)
+        Self::with_counts(cut, OctantRecords::default(), 0, 0)
     }
 
     /// A cell with `cut` and the given counts (a loaded one).
     pub(super) fn with_counts(
         cut: GuidingCut,
-        octants: OctantSplats,
+        octants: OctantRecords,
         used: u64,
         generation: u32,
     ) -> Self {
@@ -110,17 +110,17 @@ impl GltCell {
         &self.cut
     }
 
-    /// Splats (zero values included) received since the cell last took
+    /// Records (zero values included) received since the cell last took
     /// part in a refinement.
     #[inline]
-    pub fn splats(&self) -> u64 {
+    pub fn records(&self) -> u64 {
         self.octants.total()
     }
 
-    /// [`GltCell::splats`] per octant of the cell (bit 0 of the index set
+    /// [`GltCell::records`] per octant of the cell (bit 0 of the index set
     /// for `x` at or above the cell's centre, bit 1 for `y`, bit 2 for
     /// `z`).
-    pub fn octant_splats(&self) -> [u64; 8] {
+    pub fn octant_records(&self) -> [u64; 8] {
         self.octants.get()
     }
 
@@ -131,9 +131,9 @@ impl GltCell {
     }
 
     /// Starts a refinement: the cell takes part if it has 3/2 of the
-    /// splats that fell in it before its last one (any, before its first).
+    /// records that fell in it before its last one (any, before its first).
     pub(super) fn begin(&mut self) {
-        let n = self.splats();
+        let n = self.records();
         self.pass = Pass {
             ready: n > 0 && n.saturating_mul(READY_DEN) >= self.used.saturating_mul(READY_NUM),
             count: n,
@@ -165,7 +165,7 @@ impl GltCell {
     /// Ends a refinement for a cell that took part, after `rebuild`
     /// rebuilt its cut (`true`) or kept it: the cut's confidence becomes
     /// this pass's factor (rebuilt from the records the cell inherited)
-    /// or is multiplied by it (kept), the cell remembers how many splats
+    /// or is multiplied by it (kept), the cell remembers how many records
     /// it used and starts counting again.
     pub(super) fn end(&mut self, rebuilt: bool) {
         let factor = self.pass.factor;
@@ -176,7 +176,7 @@ impl GltCell {
         };
         // Its own records, not the split rule's halved count: a half that
         // got few of its parent's records refines again on few of its own.
-        self.used = self.splats();
+        self.used = self.records();
         self.generation = self.generation.saturating_add(1);
         self.octants.reset();
         self.pass = Pass::default();
@@ -198,7 +198,7 @@ mod tests {
         ];
         let tree = LightTree::build(&lights[..], BuildHeuristic::Sarh).unwrap();
         let rules = CutRules::new(&tree, CutConfig::default()).unwrap();
-        GltCell::with_counts(rules.new_cut(), OctantSplats::with(octants), used, 0)
+        GltCell::with_counts(rules.new_cut(), OctantRecords::with(octants), used, 0)
     }
 
     /// A cell takes part once it has 3/2 of what its last refinement
@@ -225,7 +225,7 @@ mod tests {
         let mut lower = cell_with([800, 0, 0, 0, 0, 0, 0, 0], 0);
         lower.begin();
         let upper = lower.split(0);
-        assert_eq!((lower.splats(), upper.splats()), (800, 0));
+        assert_eq!((lower.records(), upper.records()), (800, 0));
         assert_eq!((lower.pass.factor, upper.pass.factor), (1.0, 0.0));
         assert_eq!(
             (lower.pass.count, upper.pass.count),
@@ -233,19 +233,19 @@ mod tests {
             "PPG's halving"
         );
         let lower_y = lower.split(1);
-        assert_eq!((lower.splats(), lower_y.splats()), (800, 0));
+        assert_eq!((lower.records(), lower_y.records()), (800, 0));
         let upper_z = lower.split(2);
-        assert_eq!((lower.splats(), upper_z.splats()), (800, 0));
+        assert_eq!((lower.records(), upper_z.records()), (800, 0));
         assert_eq!(upper_z.pass.factor, 0.0);
         // Along x again: unknown, shared evenly.
         let upper_x = lower.split(0);
-        assert_eq!((lower.splats(), upper_x.splats()), (400, 400));
+        assert_eq!((lower.records(), upper_x.records()), (400, 400));
         assert_eq!((lower.pass.factor, upper_x.pass.factor), (1.0, 1.0));
 
         let mut even = cell_with([100; 8], 0);
         even.begin();
         let other = even.split(1);
-        assert_eq!((even.splats(), other.splats()), (400, 400));
+        assert_eq!((even.records(), other.records()), (400, 400));
         assert_eq!((even.pass.factor, other.pass.factor), (1.0, 1.0));
         // A twentieth of the records: still the cell's own.
         let mut skewed = cell_with([190, 10, 190, 10, 190, 10, 190, 10], 0);
@@ -265,7 +265,7 @@ mod tests {
     #[test]
     fn ending_a_pass_sets_the_confidence_and_restarts_the_count() {
         let mut c = cell_with([10, 390, 0, 0, 0, 0, 0, 0], 0);
-        assert_eq!(c.octant_splats(), [10, 390, 0, 0, 0, 0, 0, 0]);
+        assert_eq!(c.octant_records(), [10, 390, 0, 0, 0, 0, 0, 0]);
         assert_eq!(c.generation(), 0);
         c.begin();
         let mut upper = c.split(0);
@@ -273,10 +273,10 @@ mod tests {
         assert_eq!(upper.cut.confidence(), 1.0);
         c.end(false);
         assert_eq!(c.cut.confidence(), 0.5);
-        assert_eq!((c.splats(), c.used, c.generation), (0, 10, 1));
-        assert_eq!((c.octant_splats(), c.generation()), ([0; 8], 1));
+        assert_eq!((c.records(), c.used, c.generation), (0, 10, 1));
+        assert_eq!((c.octant_records(), c.generation()), ([0; 8], 1));
         c.octants.count(3);
-        assert_eq!(c.octant_splats(), [0, 0, 0, 1, 0, 0, 0, 0]);
+        assert_eq!(c.octant_records(), [0, 0, 0, 1, 0, 0, 0, 0]);
         c.begin();
         assert!(!c.pass.ready, "1 of the 15 it needs");
         for _ in 1..15 {

@@ -12,7 +12,7 @@ pub struct GltConfig {
     pub cut: CutConfig,
     /// PPG's spatial threshold `c`: a cell that takes part in its `g`-th
     /// refinement (counted from 0, see [`Glt::refine`](super::Glt::refine)) splits while its
-    /// number of splats exceeds `c * sqrt(2^g)`; each split halves the
+    /// number of records exceeds `c * sqrt(2^g)`; each split halves the
     /// count and gives both halves a copy of the cut and its statistics.
     /// Default 250: a cut learns from far fewer records than a quadtree,
     /// and finer cells paid off in every measurement (at 64 spp on `ring`
@@ -34,7 +34,7 @@ pub struct GltConfig {
     /// The spatial filter of light records
     /// ([`LightVertex::record_light`](crate::LightVertex::record_light)). Default
     /// [`SpatialFilter::Nearest`]: the estimate goes to the cell holding
-    /// the shading point. A jittering filter carries a splat into the
+    /// the shading point. A jittering filter carries a record into the
     /// neighbouring cells, also through walls, where the light it saw may
     /// be invisible; a dim room beside bright ones then learns its
     /// neighbours' lights and samples worse than without learning
@@ -45,7 +45,7 @@ pub struct GltConfig {
 impl GltConfig {
     /// Checks every field: the cut's ([`CutConfig::validate`]) and
     /// `spatial_threshold` finite and positive (at 0 every cell would
-    /// split on every splat).
+    /// split on every record).
     pub fn validate(&self) -> Result<(), ConfigError> {
         self.cut.validate()?;
         crate::error::positive("GltConfig::spatial_threshold", self.spatial_threshold)

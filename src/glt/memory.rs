@@ -1,8 +1,11 @@
-//! [`GltMemory`]: the bytes a [`Glt`](super::Glt) uses, by part.
+//! [`GltMemory`]: the bytes a [`Glt`] uses, by part.
 
+use super::Glt;
 use crate::cut::{CutMemory, CutNode};
+use crate::light_tree::LightHierarchy;
+use crate::spatial::SpatialTree;
 
-/// Bytes a [`Glt`](super::Glt) uses, by part.
+/// Bytes a [`Glt`] uses, by part.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct GltMemory {
     /// Number of cells.
@@ -31,5 +34,22 @@ impl GltMemory {
     /// shared table excluded).
     pub fn bytes_per_cell(&self) -> f64 {
         (self.total() - self.shared_bytes) as f64 / self.cells.max(1) as f64
+    }
+}
+
+impl<H: LightHierarchy> Glt<H> {
+    /// Bytes used, by part.
+    pub fn memory(&self) -> GltMemory {
+        GltMemory {
+            cells: self.spatial.cell_count(),
+            cuts: self
+                .spatial
+                .data_slice()
+                .iter()
+                .map(|c| c.cut.memory())
+                .sum(),
+            spatial_bytes: self.spatial.bytes(),
+            shared_bytes: self.rules.bytes(),
+        }
     }
 }

@@ -2,10 +2,10 @@
 //! (`src/persist/mod.rs` has the header, `docs/format.md` the layout);
 //! merging two GLTs' statistics.
 
+use super::Glt;
 use super::cell::GltCell;
 use super::config::GltConfig;
-use super::guiding_light_tree::Glt;
-use crate::cut::{CutConfig, CutRules, GuidingCut, OctantSplats};
+use crate::cut::{CutConfig, CutRules, GuidingCut, OctantRecords};
 use crate::dropped::DropCounters;
 use crate::light_tree::LightHierarchy;
 use crate::light_tree::{fingerprint, read_fingerprint, shape_fingerprint};
@@ -53,7 +53,7 @@ impl<H: LightHierarchy> Glt<H> {
         self.dropped.write(&mut w);
         self.spatial.write(&mut w, |cell, w| {
             cell.cut.write(w);
-            // Version 3: the splats per octant, the splats that fell in the
+            // Version 3: the records per octant, the records that fell in the
             // cell before its last refinement, its refinement count.
             cell.octants.write(w);
             w.u64(cell.used);
@@ -68,34 +68,34 @@ impl<H: LightHierarchy> Glt<H> {
     /// files before format version 4: the very same tree), else
     /// [`LoadError::LightTreeMismatch`]. Everything is checked; a GLT that loads samples, gives
     /// pmfs and learns exactly like the one saved.
-    pub fn from_bytes(bytes: &[u8], tree: H) -> Result<Self, LoadError> {
+    pub fn from_bytes(bytes: &[u8], light_tree: H) -> Result<Self, LoadError> {
         let mut r = Reader::open(bytes, Kind::Glt)?;
-        read_fingerprint(&mut r, &tree)?;
+        read_fingerprint(&mut r, &light_tree)?;
         let at = r.offset();
         let config = GltConfig::read(&mut r)?;
-        let guide = CutRules::new(tree, config.cut).map_err(|e| e.at(at))?;
+        let rules = CutRules::new(light_tree, config.cut).map_err(|e| e.at(at))?;
         let iteration = r.u32("iteration")?;
         let dropped = DropCounters::read(&mut r)?;
         let spatial = crate::spatial::BinaryTree::read(&mut r, |r| {
-            let cut = GuidingCut::read(r, &guide)?;
+            let cut = GuidingCut::read(r, &rules)?;
             if r.version() < 3 {
-                // Versions 1 and 2 counted a cell's splats as one number
+                // Versions 1 and 2 counted a cell's records as one number
                 // (and a split count that only lives inside a refinement):
                 // spread evenly over the octants; every cell had taken
                 // part in every refinement.
-                let splats = r.u64("cell: splats")?;
+                let records = r.u64("cell: records")?;
                 r.u64("cell: split count")?;
-                let octants = OctantSplats::spread(splats);
+                let octants = OctantRecords::spread(records);
                 return Ok(GltCell::with_counts(cut, octants, 0, iteration));
             }
-            let octants = OctantSplats::read(r, "cell: octant splats")?;
-            let used = r.u64("cell: splats used")?;
+            let octants = OctantRecords::read(r, "cell: octant records")?;
+            let used = r.u64("cell: records used")?;
             let generation = r.u32("cell: generation")?;
             Ok(GltCell::with_counts(cut, octants, used, generation))
         })?;
         r.end()?;
         Ok(Self {
-            guide,
+            rules,
             config,
             spatial,
             iteration,
@@ -103,7 +103,7 @@ impl<H: LightHierarchy> Glt<H> {
         })
     }
 
-    /// Zeroes everything recorded since the last refinement (sums, splat
+    /// Zeroes everything recorded since the last refinement (sums, record
     /// and drop counts), keeping what was learned: the starting point of a
     /// worker's share (see [`Glt::merge`]).
     pub fn clear_records(&mut self) {
@@ -119,7 +119,7 @@ impl<H: LightHierarchy> Glt<H> {
     /// coordinator sends its state; each worker loads it, calls
     /// [`Glt::clear_records`] (so its share holds only its own records,
     /// not the coordinator's, which may carry sums a cut below
-    /// [`CutConfig::min_splats`](crate::cut::CutConfig::min_splats) keeps from
+    /// [`CutConfig::min_records`](crate::cut::CutConfig::min_records) keeps from
     /// earlier iterations), records, and sends the share back; the
     /// coordinator merges every share into its state and refines. Both
     /// must have the same light hierarchy, configuration, spatial tree and

@@ -9,7 +9,7 @@ use crate::light_tree::LightHierarchy;
 use crate::math::Descent;
 
 /// Descends a [`LightHierarchy`] choosing, at each inner node, between the
-/// two children in proportion to their [`super::importance`] at the shading
+/// two children in proportion to their [`super::importance()`] at the shading
 /// point: power x orientation bound / clamped distance^2, x the normal bound
 /// when the context has a normal.
 ///
@@ -30,9 +30,9 @@ pub struct ImportanceTreeSampler<H: LightHierarchy> {
 }
 
 impl<H: LightHierarchy> ImportanceTreeSampler<H> {
-    /// A sampler over `tree`'s emitters.
-    pub fn new(tree: H) -> Self {
-        Self { tree }
+    /// A sampler over `light_tree`'s emitters.
+    pub fn new(light_tree: H) -> Self {
+        Self { tree: light_tree }
     }
 
     /// The hierarchy it descends.

@@ -23,9 +23,9 @@ pub struct PowerTreeSampler<H: LightHierarchy> {
 }
 
 impl<H: LightHierarchy> PowerTreeSampler<H> {
-    /// A sampler over `tree`'s emitters.
-    pub fn new(tree: H) -> Self {
-        Self { tree }
+    /// A sampler over `light_tree`'s emitters.
+    pub fn new(light_tree: H) -> Self {
+        Self { tree: light_tree }
     }
 
     /// The hierarchy it descends.

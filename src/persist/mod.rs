@@ -20,8 +20,8 @@
 //! saved, and a corrupted or hostile one is a [`LoadError`] naming the
 //! field and offset. No length in a buffer is trusted beyond the bytes
 //! that follow it. Counts of what was recorded are data, not lengths, and
-//! are taken as they are: a buffer claiming 2^60 splats in a cell makes the
-//! next `refine` split that cell as 2^60 splats would, so load buffers from
+//! are taken as they are: a buffer claiming 2^60 records in a cell makes the
+//! next `refine` split that cell as 2^60 records would, so load buffers from
 //! untrusted sources into a structure whose refinement is bounded
 //! (`max_bytes`), or do not refine them.
 //!

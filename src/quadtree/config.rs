@@ -1,4 +1,4 @@
-//! Refinement parameters, the directional splat filters and the constants
+//! Refinement parameters, the directional record filters and the constants
 //! that bound a directional tree.
 
 use crate::math::SPHERE_MAP_JACOBIAN;
@@ -95,7 +95,7 @@ impl QuadtreeConfig {
     }
 }
 
-/// How a splat is spread over the building copy's leaves.
+/// How a record is spread over the building copy's leaves.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum DirectionalFilter {
     /// All of the value goes to the leaf containing the direction.
@@ -106,7 +106,7 @@ pub enum DirectionalFilter {
     /// area the square overlaps each leaf. The square wraps around in `v`
     /// (the azimuth is periodic, `phi = 0` and `2 pi` are the same meridian)
     /// and is clipped at `u = 0` and `u = 1` (the poles); the weights are
-    /// divided by the area left inside the domain, so the total splatted is
+    /// divided by the area left inside the domain, so the total recorded is
     /// always the value (up to one `f32` rounding per leaf touched).
     Box,
 }

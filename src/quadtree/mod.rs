@@ -2,10 +2,10 @@
 //! equal-area sphere map.
 //!
 //! A [`DirectionalTree`] learns a distribution of directions from radiance
-//! splats and samples it. It keeps two copies, as PPG does:
+//! records and samples it. It keeps two copies, as PPG does:
 //! - the *sampling* copy answers [`DirectionalTree::sample`] and
 //!   [`DirectionalTree::pdf`]; it is plain data, read-only between refines;
-//! - the *building* copy collects [`DirectionalTree::splat`]s from many
+//! - the *building* copy collects [`DirectionalTree::record`]s from many
 //!   threads through `&self` into thread-safe sums (`src/math/sum.rs`)
 //!   (lock-free, no lost update, no `f32` accumulation error, bit-identical in
 //!   [`Accumulation::Deterministic`](crate::math::Accumulation) mode).
@@ -44,8 +44,8 @@ mod leaves;
 mod node;
 mod persist;
 mod query;
+mod record;
 mod refine;
-mod splat;
 mod sums;
 mod tree;
 

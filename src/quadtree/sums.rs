@@ -5,7 +5,7 @@ use crate::math::SumBuffer;
 use alloc::vec::Vec;
 
 /// The building copy's sums in `f64`, four per node, made consistent: mass a
-/// box splat left on an inner quadrant is spread evenly over the leaves below
+/// box record left on an inner quadrant is spread evenly over the leaves below
 /// it (a quarter per level), then every inner quadrant holds the total of its
 /// child node. Leaf quadrants hold what landed in them. The same inputs give
 /// the same bits (fixed order of operations).

@@ -8,7 +8,7 @@ use alloc::vec::Vec;
 
 /// PPG's directional quadtree: one per spatial cell, holding a sampling copy
 /// (what [`sample`](Self::sample) and [`pdf`](Self::pdf) read) and a building
-/// copy (what [`splat`](Self::splat) adds to).
+/// copy (what [`record`](Self::record) adds to).
 ///
 /// `Clone` copies both copies, the sums collected so far included (a spatial
 /// cell that splits gives both children its tree).
@@ -21,7 +21,7 @@ use alloc::vec::Vec;
 /// let mut tree = DirectionalTree::new(Accumulation::Fast);
 /// assert_eq!(tree.pdf(Vec3::Z), UNIFORM_PDF);
 /// for _ in 0..100 {
-///     tree.splat(Vec3::Z, 1.0, DirectionalFilter::Nearest);
+///     tree.record(Vec3::Z, 1.0, DirectionalFilter::Nearest);
 /// }
 /// tree.refine(&QuadtreeConfig::default());
 /// assert!(tree.pdf(Vec3::Z) > 2.0 * UNIFORM_PDF);
@@ -40,7 +40,7 @@ pub struct DirectionalTree {
     pub(super) building_depth: u32,
     /// Four sums per building node (quadrant `q` of node `n` at `4 n + q`).
     /// A leaf quadrant's sum is what landed in it; an inner quadrant's sum is
-    /// mass a box splat spread evenly over all of it.
+    /// mass a box record spread evenly over all of it.
     pub(super) sums: SumBuffer,
     /// Weight of the uniform part of the density.
     pub(super) uniform_fraction: f64,
@@ -132,7 +132,7 @@ impl DirectionalTree {
         self.sampling_depth as usize
     }
 
-    /// Nodes in the building copy (what splats walk).
+    /// Nodes in the building copy (what records walk).
     pub fn building_node_count(&self) -> usize {
         self.links.len()
     }

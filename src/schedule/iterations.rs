@@ -56,7 +56,7 @@ pub fn next_iteration(index: u32, remaining_passes: u64) -> Option<Iteration> {
 /// e.g. before the first pass) it plans `2^index` passes, not last. `None`
 /// when the time left does not pay for one pass.
 ///
-/// The measurement comes from a training iteration, which also splats
+/// The measurement comes from a training iteration, which also records
 /// records; the last iteration only renders and is usually cheaper per
 /// pass, so it affords more passes than planned here. A renderer with a
 /// hard deadline should render the last iteration until the time is up

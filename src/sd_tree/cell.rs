@@ -1,5 +1,5 @@
 //! What one spatial cell of the SD-tree holds, and everything done to one
-//! cell: queries, recording a splat or a fraction sample, the end of an
+//! cell: queries, recording a record or a fraction sample, the end of an
 //! iteration. The SD-tree and the combined guiding field
 //! ([`crate::field`]) both work through these.
 
@@ -92,7 +92,7 @@ impl SdCell {
     }
 
     /// Statistical weight collected since the last refinement (about the
-    /// number of splats; fractions of one with box filters). Read it between
+    /// number of records; fractions of one with box filters). Read it between
     /// iterations.
     #[inline]
     pub fn building_weight(&self) -> f64 {
@@ -112,12 +112,12 @@ impl SdCell {
             .saturating_sub(core::mem::size_of::<DirectionalTree>())
     }
 
-    /// Records the `weight` part of a validated splat: `weight` to the
+    /// Records the `weight` part of a validated record: `weight` to the
     /// statistical weight, `value * weight` to the quadtree along `dir`.
     #[inline]
     pub(super) fn record(&self, dir: Vec3, value: f32, weight: f32, filter: DirectionalFilter) {
         self.stats.add(WEIGHT, weight);
-        self.directions.splat(dir, value * weight, filter);
+        self.directions.record(dir, value * weight, filter);
     }
 
     /// Records a validated sample for the fraction learner.

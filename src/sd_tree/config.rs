@@ -11,7 +11,7 @@ use crate::spatial::SpatialFilter;
 pub struct SdTreeConfig {
     /// `c` of the spatial split rule: after iteration `k` a cell splits
     /// while the statistical weight it collected (about its number of
-    /// splats) exceeds `c * sqrt(2^k)`. Default 12000 (the paper). The
+    /// records) exceeds `c * sqrt(2^k)`. Default 12000 (the paper). The
     /// "improved" setting 4000 splits at a third of the samples, giving a
     /// finer spatial subdivision for the same budget; PPG's released code
     /// uses 4000 scaled by `sqrt(spp per pass / 4)`. Finite and positive.

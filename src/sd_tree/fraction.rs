@@ -1,4 +1,4 @@
-//! The learned BSDF sampling fraction of a cell: the statistics splats leave
+//! The learned BSDF sampling fraction of a cell: the statistics records leave
 //! and the Adam optimiser that runs on them between iterations.
 //!
 //! The loss is the KL divergence from the (normalised) integrand `f` to the

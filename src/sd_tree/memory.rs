@@ -50,7 +50,7 @@ impl SdTreeMemory {
 impl SdTree {
     /// Bytes and node counts, per structure.
     pub fn memory(&self) -> SdTreeMemory {
-        SdTreeMemory::of(&self.tree)
+        SdTreeMemory::of(&self.spatial)
     }
 
     /// Bytes per spatial node word.

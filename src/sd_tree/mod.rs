@@ -106,14 +106,28 @@
 //! assert_eq!(tree.dropped_records().radiance, 1);
 //! # Ok::<(), guiding::Error>(())
 //! ```
+//!
+//! The same files as `glt/` and `field/`, and three of its own:
+//! - `mod.rs`: [`SdTree`], its construction and what it hands out;
+//! - `config.rs`: [`SdTreeConfig`];
+//! - `cell.rs`: [`SdCell`], a cell's quadtree, weight and fraction;
+//! - `vertex.rs`: the one lookup per path vertex ([`DirectionVertex`]) and
+//!   where its records go;
+//! - `refine.rs`: PPG's spatial and directional refinement;
+//! - `persist.rs`: saving, loading and merging an SD-tree;
+//! - `memory.rs`: [`SdTreeMemory`];
+//! - `record.rs`, `validate.rs`, `state.rs`: the radiance and fraction
+//!   records, what they drop, and the state an SD-tree and a guiding field
+//!   share (configuration, iteration, drop counters);
+//! - `fraction.rs`: the learned BSDF sampling fraction.
 
 mod cell;
 mod config;
 mod fraction;
 mod memory;
 mod persist;
+mod record;
 mod refine;
-mod splat;
 mod state;
 mod validate;
 mod vertex;
@@ -133,7 +147,7 @@ use crate::spatial::BinaryTree;
 /// Practical Path Guiding's SD-tree. See the module docs.
 #[derive(Clone, Debug)]
 pub struct SdTree {
-    tree: BinaryTree<SdCell>,
+    spatial: BinaryTree<SdCell>,
     state: SdState,
 }
 
@@ -145,7 +159,7 @@ impl SdTree {
         config.validate()?;
         let state = SdState::new(config);
         Ok(Self {
-            tree: BinaryTree::new(scene, state.new_cell())?,
+            spatial: BinaryTree::new(scene, state.new_cell())?,
             state,
         })
     }
@@ -153,7 +167,7 @@ impl SdTree {
     /// The spatial tree and its cells.
     #[inline]
     pub fn spatial(&self) -> &BinaryTree<SdCell> {
-        &self.tree
+        &self.spatial
     }
 
     /// The configuration.
@@ -171,10 +185,10 @@ impl SdTree {
     /// Number of spatial cells.
     #[inline]
     pub fn cell_count(&self) -> usize {
-        self.tree.data_slice().len()
+        self.spatial.data_slice().len()
     }
 
-    /// Splats and fraction records dropped for bad input so far, per reason.
+    /// Radiance and fraction records dropped for bad input so far, per reason.
     pub fn dropped_records(&self) -> DroppedRecords {
         self.state.dropped.snapshot()
     }

@@ -140,7 +140,7 @@ impl SdTree {
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut w = Writer::default();
         self.state.write(&mut w);
-        self.tree.write(&mut w, |cell, w| cell.write(w));
+        self.spatial.write(&mut w, |cell, w| cell.write(w));
         w.finish(Kind::SdTree)
     }
 
@@ -149,16 +149,16 @@ impl SdTree {
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, LoadError> {
         let mut r = Reader::open(bytes, Kind::SdTree)?;
         let state = SdState::read(&mut r)?;
-        let tree = BinaryTree::read(&mut r, |r| SdCell::read(r, &state.config))?;
+        let spatial = BinaryTree::read(&mut r, |r| SdCell::read(r, &state.config))?;
         r.end()?;
-        Ok(Self { tree, state })
+        Ok(Self { spatial, state })
     }
 
     /// Zeroes everything recorded since the last refinement (building
     /// sums, statistics, drop counts), keeping what was learned: the
     /// starting point of a worker's share (see [`SdTree::merge`]).
     pub fn clear_records(&mut self) {
-        for cell in self.tree.data_slice_mut() {
+        for cell in self.spatial.data_slice_mut() {
             cell.clear_records();
         }
         self.state.dropped.reset();
@@ -172,21 +172,21 @@ impl SdTree {
     pub fn merge(&mut self, other: &Self) -> bool {
         let same = self.state.config == other.state.config
             && self.state.iteration == other.state.iteration
-            && self.tree.same_layout(&other.tree)
+            && self.spatial.same_layout(&other.spatial)
             && self
-                .tree
+                .spatial
                 .data_slice()
                 .iter()
-                .zip(other.tree.data_slice())
+                .zip(other.spatial.data_slice())
                 .all(|(a, b)| a.same_layout(b));
         if !same || !self.state.merge(&other.state) {
             return false;
         }
         for (a, b) in self
-            .tree
+            .spatial
             .data_slice_mut()
             .iter_mut()
-            .zip(other.tree.data_slice())
+            .zip(other.spatial.data_slice())
         {
             a.merge(b);
         }

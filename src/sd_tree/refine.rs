@@ -64,7 +64,7 @@ impl SdTree {
     /// zeroes the collected sums. Returns what the spatial pass did.
     pub fn refine(&mut self) -> RefineOutcome {
         self.state.refine(
-            &mut self.tree,
+            &mut self.spatial,
             |_| Growth::default(),
             |_, _| {},
             |_, _, _| {},

@@ -1,5 +1,5 @@
 //! [`SdState`]: what an SD-tree keeps besides its cells. Its operations
-//! (`splat`, `record_fraction`, `refine` and the memory report) work on a
+//! (`record`, `record_fraction`, `refine` and the memory report) work on a
 //! spatial tree of any cell type that holds an [`SdCell`], so the SD-tree
 //! and the combined guiding field ([`crate::field`]) share them.
 

@@ -1,10 +1,10 @@
-//! Checking the inputs of queries and splats.
+//! Checking the inputs of queries and records.
 
 use crate::dropped::DropReason;
 
-/// The value a splat records, `radiance / pdf`, or why it is dropped.
+/// The value a radiance record adds, `radiance / pdf`, or why it is dropped.
 #[inline]
-pub(super) fn splat_value(radiance: f32, pdf: f32) -> Result<f32, DropReason> {
+pub(super) fn record_value(radiance: f32, pdf: f32) -> Result<f32, DropReason> {
     if !(radiance >= 0.0 && radiance.is_finite()) {
         return Err(DropReason::Radiance);
     }

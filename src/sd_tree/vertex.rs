@@ -21,7 +21,7 @@ impl RadianceCells for SdTree {
     #[inline]
     fn record_radiance(&self, at: Located, dir: Vec3, radiance: f32, pdf: f32) -> RecordOutcome {
         self.state
-            .record_radiance(&self.tree, at, dir, radiance, pdf)
+            .record_radiance(&self.spatial, at, dir, radiance, pdf)
     }
 }
 
@@ -175,7 +175,7 @@ impl SdTree {
     #[inline]
     pub fn vertex(&self, ctx: &ShadingContext) -> Option<DirectionVertex<'_>> {
         let p = ctx.position;
-        let Some(at) = self.tree.locate_with_bounds(p) else {
+        let Some(at) = self.spatial.locate_with_bounds(p) else {
             self.state
                 .dropped
                 .count(crate::dropped::DropReason::Position);
@@ -183,7 +183,7 @@ impl SdTree {
         };
         Some(DirectionVertex::new(
             &self.state,
-            self.tree.data(at.0),
+            self.spatial.data(at.0),
             (p, at),
             self,
         ))

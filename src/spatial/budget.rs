@@ -30,7 +30,7 @@ impl Growth {
 }
 
 /// The factor every cell's node count is scaled by so that
-/// `spatial_bytes` plus every part's [`Growth::bytes`] stays within
+/// `spatial_bytes` plus every part's growth (`fixed + nodes * per_node`) stays within
 /// `max_bytes`; `None` when it fits as it is (or there is no budget).
 pub(crate) fn content_scale(
     max_bytes: Option<usize>,

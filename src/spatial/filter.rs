@@ -1,7 +1,7 @@
 //! Spatial filters: how a record made at a point is spread over cells.
 //!
 //! One implementation for every structure that learns per cell (the
-//! SD-tree's radiance splats, the Guiding Light Tree's light splats, the
+//! SD-tree's radiance records, the Guiding Light Tree's light records, the
 //! combined guiding field's both): [`BinaryTree::spread`] turns a point into
 //! `(cell, weight)` pairs and the caller records into each cell.
 
@@ -9,7 +9,7 @@ use super::{BinaryTree, CellId, SpatialTree};
 use crate::math::Aabb;
 use glam::Vec3;
 
-/// How a splat is spread over spatial cells.
+/// How a record is spread over spatial cells.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum SpatialFilter {
     /// All of it goes to the cell containing the position.
@@ -65,7 +65,7 @@ impl<T> BinaryTree<T> {
 
     /// [`BinaryTree::spread`] for a point already located: `at` is what
     /// [`BinaryTree::locate_with_bounds`] returned for `p` (so one lookup
-    /// per path vertex can serve its queries and its splats).
+    /// per path vertex can serve its queries and its records).
     #[inline]
     pub fn spread_from(
         &self,

@@ -53,10 +53,10 @@ pub struct Args {
     /// the crate's default).
     #[arg(long, default_value = "importance", value_parser = parse_below_cut)]
     pub below_cut: BelowCut,
-    /// The fewest non-zero light splats a cut rebuilds from
-    /// (`guiding::cut::CutConfig::min_splats`; 0 = the paper's rule).
-    #[arg(long, default_value_t = guiding::cut::CutConfig::default().min_splats)]
-    pub min_splats: u32,
+    /// The fewest non-zero light records a cut rebuilds from
+    /// (`guiding::cut::CutConfig::min_records`; 0 = the paper's rule).
+    #[arg(long, default_value_t = guiding::cut::CutConfig::default().min_records)]
+    pub min_records: u32,
     /// The GLT's defensive mixture weight alpha
     /// (`guiding::cut::CutConfig::alpha`).
     #[arg(long, default_value_t = guiding::cut::CutConfig::default().alpha)]
@@ -66,11 +66,11 @@ pub struct Args {
     /// the crate's default).
     #[arg(long, default_value = "importance", value_parser = parse_modulation)]
     pub modulation: Modulation,
-    /// Light splats carry the full contribution `f cos Le w / p` instead of
+    /// Light records carry the full contribution `f cos Le w / p` instead of
     /// the paper's `Le w / p`.
     #[arg(long)]
-    pub contribution_splats: bool,
-    /// Light splats (`pt-glt` and `ppg-glt`) jitter into neighbouring cells
+    pub contribution_records: bool,
+    /// Light records (`pt-glt` and `ppg-glt`) jitter into neighbouring cells
     /// (PPG's stochastic box, as the paper does) instead of going to the
     /// shading point's own cell.
     #[arg(long)]
@@ -108,9 +108,9 @@ pub struct Args {
     pub visibility: bool,
     /// Run `pt-glt` and `ppg-glt` exactly as the paper describes: power
     /// below the cut, one distribution per cell, no defensive mixture
-    /// (alpha 0), rebuild from any data (min-splats 0), jittered light
-    /// splats. Overrides `--below-cut`, `--modulation`, `--prior`,
-    /// `--alpha`, `--min-splats` and `--glt-jitter`.
+    /// (alpha 0), rebuild from any data (min-records 0), jittered light
+    /// records. Overrides `--below-cut`, `--modulation`, `--prior`,
+    /// `--alpha`, `--min-records` and `--glt-jitter`.
     #[arg(long)]
     pub paper_rules: bool,
     /// Worker threads [default: all cores].
@@ -124,7 +124,7 @@ pub struct Args {
     #[arg(long, default_value_t = 4000.0)]
     pub spatial_threshold: f64,
     /// The same threshold for the GLT's own spatial tree (`pt-glt`), which
-    /// counts light splats: finer cells pay off there (the library's
+    /// counts light records: finer cells pay off there (the library's
     /// default).
     #[arg(long, default_value_t = guiding::glt::GltConfig::default().spatial_threshold)]
     pub glt_spatial_threshold: f64,

@@ -39,9 +39,9 @@ pub struct Guides<'a> {
     pub field: Option<&'a GuidingField<&'a LightTree>>,
     /// Whether to record training data this pass.
     pub train: bool,
-    /// Light splats carry the full contribution `f cos Le w / p` instead of
+    /// Light records carry the full contribution `f cos Le w / p` instead of
     /// the paper's `Le w / p` (without the BSDF and cosine).
-    pub contribution_splats: bool,
+    pub contribution_records: bool,
     /// Candidates of resampled next-event estimation
     /// (`guiding::resampling`, at most [`MAX_CANDIDATES`]), resampled with
     /// the light the continuation finds; 0 samples the light sampler
@@ -75,7 +75,7 @@ struct Vertex<'a> {
     pos: Vec3,
     normal: Vec3,
     pdf_dir: f32,
-    /// `f cos` of the direction sampled here (for contribution splats).
+    /// `f cos` of the direction sampled here (for contribution records).
     f_cos: Vec3,
     delta: bool,
     /// Resampled NEE here took the light the continuation found as a
@@ -85,11 +85,11 @@ struct Vertex<'a> {
     nee: u32,
 }
 
-/// The scalar a light splat starts from: the luminance of the arriving
-/// radiance `le`, times `f cos` with contribution splats.
+/// The scalar a light record starts from: the luminance of the arriving
+/// radiance `le`, times `f cos` with contribution records.
 #[inline]
-fn splat_value(guides: &Guides, f_cos: Vec3, le: Vec3) -> f32 {
-    if guides.contribution_splats {
+fn record_value(guides: &Guides, f_cos: Vec3, le: Vec3) -> f32 {
+    if guides.contribution_records {
         luminance(f_cos * le)
     } else {
         luminance(le)
@@ -122,7 +122,7 @@ fn found_light(
     } * v.nee as f32;
     let d = Convention::PbrtV4.bsdf_sample(pmf, pdf_light(&v), v.pdf_dir);
     recorder.add_radiance(le * d.weight);
-    let value = splat_value(guides, v.f_cos, le) * d.factor;
+    let value = record_value(guides, v.f_cos, le) * d.factor;
     if let Some(l) = v.light.filter(|_| guides.train && value > 0.0) {
         l.record_light(id, value);
     }
@@ -377,7 +377,7 @@ pub fn radiance<'a>(
             if !c.is_finite() {
                 continue;
             }
-            let value = splat_value(guides, f, lp.radiance) * factor;
+            let value = record_value(guides, f, lp.radiance) * factor;
             if visible {
                 recorder.add_radiance(c);
                 if let Some(l) = here.light.filter(|_| train_light) {

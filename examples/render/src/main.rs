@@ -10,7 +10,7 @@
 //! One concept per file: `cli` (flags), `scenes/` (scene generators),
 //! `scene` (scene container, effect declarations), `geometry` + `bvh`
 //! (primitives, obvhs ray casting), `materials`, `lights`, `camera`,
-//! `integrator` (the path tracer and its training splats), `methods` (which
+//! `integrator` (the path tracer and its training records), `methods` (which
 //! crate objects a method uses), `run` (passes, training schedule,
 //! combination), `film` (EXR/PNG), `reference` (cache), `metrics`,
 //! `report` (JSON, table), `sheet` (comparison sheet).
@@ -113,10 +113,10 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
         spatial_threshold: args.spatial_threshold,
         glt_spatial_threshold: args.glt_spatial_threshold,
         below_cut: args.below_cut,
-        min_splats: args.min_splats,
+        min_records: args.min_records,
         alpha: args.alpha,
         modulation: args.modulation,
-        contribution_splats: args.contribution_splats,
+        contribution_records: args.contribution_records,
         glt_filter: if args.glt_jitter {
             SpatialFilter::StochasticBox
         } else {

@@ -99,19 +99,19 @@ pub struct GuideParams {
     /// PPG's spatial split threshold `c` (radiance records), for the
     /// SD-tree and the combined field.
     pub spatial_threshold: f64,
-    /// The spatial split threshold of the GLT's own tree (light splats).
+    /// The spatial split threshold of the GLT's own tree (light records).
     pub glt_spatial_threshold: f64,
     /// The GLT's rule below its cut.
     pub below_cut: BelowCut,
-    /// The fewest non-zero light splats a cut rebuilds from.
-    pub min_splats: u32,
+    /// The fewest non-zero light records a cut rebuilds from.
+    pub min_records: u32,
     /// The weight of the GLT's defensive mixture with the power prior.
     pub alpha: f64,
     /// Whether the GLT's cut probabilities vary inside a cell.
     pub modulation: Modulation,
-    /// Light splats carry `f cos Le w / p` (else the paper's `Le w / p`).
-    pub contribution_splats: bool,
-    /// The spatial filter of the light splats (`pt-glt`'s GLT and
+    /// Light records carry `f cos Le w / p` (else the paper's `Le w / p`).
+    pub contribution_records: bool,
+    /// The spatial filter of the light records (`pt-glt`'s GLT and
     /// `ppg-glt`'s field).
     pub glt_filter: SpatialFilter,
     /// The GLT's defensive prior.
@@ -141,10 +141,10 @@ impl Default for GuideParams {
             spatial_threshold: 4000.0,
             glt_spatial_threshold: guiding::glt::GltConfig::default().spatial_threshold,
             below_cut: cut.below_cut,
-            min_splats: cut.min_splats,
+            min_records: cut.min_records,
             alpha: cut.alpha,
             modulation: cut.modulation,
-            contribution_splats: false,
+            contribution_records: false,
             glt_filter: GltConfig::default().light_filter,
             prior: cut.prior,
             visibility: cut.visibility,
@@ -159,7 +159,7 @@ impl Default for GuideParams {
 impl GuideParams {
     /// These parameters with the paper's GLT rules: power below the cut,
     /// one distribution per cell, the power prior at weight 0 (no
-    /// defensive mixture), rebuild from any data, jittered light splats.
+    /// defensive mixture), rebuild from any data, jittered light records.
     pub fn paper_rules(self) -> Self {
         let cut = CutConfig::default().with_paper_rules();
         Self {
@@ -167,7 +167,7 @@ impl GuideParams {
             modulation: cut.modulation,
             prior: cut.prior,
             alpha: 0.0,
-            min_splats: 0,
+            min_records: 0,
             glt_filter: SpatialFilter::StochasticBox,
             ..self
         }
@@ -202,7 +202,7 @@ fn cut_config(scene: &Scene, params: &GuideParams) -> CutConfig {
     CutConfig {
         sigma: params.sigma,
         below_cut: params.below_cut,
-        min_splats: params.min_splats,
+        min_records: params.min_records,
         alpha: params.alpha,
         modulation: params.modulation,
         prior: params.prior,

@@ -499,7 +499,7 @@ pub fn guides<'r, 's: 'r>(
         sd_tree: sd_tree.as_ref(),
         field: field.as_ref(),
         train,
-        contribution_splats: params.contribution_splats,
+        contribution_records: params.contribution_records,
         resample_vertices: params.resample_vertices,
         nee_samples: params.nee_samples.max(1),
         nee_samples_vertices: params.nee_samples_vertices,

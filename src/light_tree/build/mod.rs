@@ -1,7 +1,7 @@
 //! Building the light tree: the emitters checked ([`items`]), split top-down
 //! with one of four heuristics ([`heuristic`], [`binned`]), aggregated
 //! bottom-up ([`cone_bound`]), then quantised into [`LightNode`]s; and
-//! [`refit`], the same aggregation over a built tree's shape when its
+//! [`refit`](mod@refit), the same aggregation over a built tree's shape when its
 //! emitters move.
 
 mod binned;

@@ -116,7 +116,7 @@ fn render_passes(
         sd_tree: None,
         field: Some(field),
         train,
-        contribution_splats: false,
+        contribution_records: false,
         resample: 0,
         resample_vertices: 1,
         nee_samples: 1,

@@ -27,9 +27,9 @@ impl GltVariant {
 
     /// Parses `spec`: space-separated `key=value` (sigma, alpha,
     /// below=power|importance, modulation=none|importance,
-    /// splat=radiance|contribution, filter=nearest|jitter,
+    /// record=radiance|contribution, filter=nearest|jitter,
     /// prior=power|importance, rules=paper (the paper's rules, see the
-    /// render example's `--paper-rules`), min-splats, threshold,
+    /// render example's `--paper-rules`), min-records, threshold,
     /// train-spp) applied in order to the defaults.
     pub fn parse(spec: &str, train_spp: u64) -> Result<Self, String> {
         let mut v = Self::defaults(train_spp);
@@ -69,8 +69,8 @@ impl GltVariant {
                         ],
                     )?
                 }
-                "splat" => {
-                    v.params.contribution_splats =
+                "record" => {
+                    v.params.contribution_records =
                         pick(kv, val, [("radiance", false), ("contribution", true)])?
                 }
                 "filter" => {
@@ -92,7 +92,7 @@ impl GltVariant {
                 "visibility" => {
                     v.params.visibility = pick(kv, val, [("on", true), ("off", false)])?
                 }
-                "min-splats" => v.params.min_splats = num()? as u32,
+                "min-records" => v.params.min_records = num()? as u32,
                 "train-spp" => v.train_spp = num()? as u64,
                 _ => return Err(format!("`{kv}`: unknown key {k:?}")),
             }

@@ -9,7 +9,7 @@ use crate::record::RecordOutcome;
 use glam::Vec3;
 
 impl GuidingCut {
-    /// Index of the sum that a splat for `emitter` goes to: the first slot on
+    /// Index of the sum that a record for `emitter` goes to: the first slot on
     /// its root-to-leaf path that ends the cut. `None` for an emitter out of
     /// range or with zero power.
     pub(crate) fn slot_of<H: LightHierarchy + ?Sized>(
@@ -59,13 +59,13 @@ impl<H: LightHierarchy> CutRules<H> {
     /// emitter hit, `Le * w_mis / pdf_direction` (use the luminance, or any
     /// fixed scalar, of a spectral value). The value goes to the first slot
     /// on the emitter's path that ends the cut (or to the unbounded light's
-    /// sum). Takes `&self`: any number of threads may splat at once, no
+    /// sum). Takes `&self`: any number of threads may record at once, no
     /// update is lost.
     ///
-    /// The splat carries no position, so a cut trained only through this
+    /// The record carries no position, so a cut trained only through this
     /// call has no anchor for [`Modulation::Importance`]; use
-    /// [`CutRules::splat_from`] there.
-    pub fn splat(&self, cut: &GuidingCut, light: LightId, value: f32) -> RecordOutcome {
+    /// [`CutRules::record_from`] there.
+    pub fn record(&self, cut: &GuidingCut, light: LightId, value: f32) -> RecordOutcome {
         if !(value >= 0.0 && value.is_finite()) {
             return RecordOutcome::Dropped;
         }
@@ -77,8 +77,8 @@ impl<H: LightHierarchy> CutRules<H> {
         }
         if cut.sums.add(index, value) {
             // Only the data floor reads the count: the paper's rule
-            // (`min_splats` 0) pays no second atomic per splat.
-            if self.config().min_splats > 0 {
+            // (`min_records` 0) pays no second atomic per record.
+            if self.config().min_records > 0 {
                 cut.recorded.bump();
             }
             RecordOutcome::Recorded
@@ -87,26 +87,26 @@ impl<H: LightHierarchy> CutRules<H> {
         }
     }
 
-    /// [`CutRules::splat`] of an estimate made at the shading point
-    /// `from`: with [`Modulation::Importance`] a recorded splat also adds
+    /// [`CutRules::record`] of an estimate made at the shading point
+    /// `from`: with [`Modulation::Importance`] a record also adds
     /// `from` to the cut's anchor (the mean position its learned weights
     /// come from). The cells of [`crate::glt::Glt`] and of the combined
-    /// field splat this way.
-    pub fn splat_from(
+    /// field record this way.
+    pub fn record_from(
         &self,
         cut: &GuidingCut,
         from: Vec3,
         light: LightId,
         value: f32,
     ) -> RecordOutcome {
-        self.splat_weighted_from(cut, from, 1.0, light, value)
+        self.record_weighted_from(cut, from, 1.0, light, value)
     }
 
-    /// [`CutRules::splat_from`] for the share `weight` of a splat that
+    /// [`CutRules::record_from`] for the share `weight` of a record that
     /// a spatial filter spread over several cells (`value` is already
     /// scaled; the anchor takes `from` with this weight).
     #[inline]
-    pub(crate) fn splat_weighted_from(
+    pub(crate) fn record_weighted_from(
         &self,
         cut: &GuidingCut,
         from: Vec3,
@@ -114,7 +114,7 @@ impl<H: LightHierarchy> CutRules<H> {
         light: LightId,
         value: f32,
     ) -> RecordOutcome {
-        let outcome = self.splat(cut, light, value);
+        let outcome = self.record(cut, light, value);
         if outcome == RecordOutcome::Recorded && self.config().modulation != Modulation::None {
             cut.record_position(from, weight);
         }

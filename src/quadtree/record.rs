@@ -22,7 +22,7 @@ impl DirectionalTree {
     /// nothing, for a NaN, infinite or negative value or a zero, NaN or
     /// infinite direction; a direction of any positive length is normalised.
     /// A zero value is accepted and changes nothing.
-    pub fn splat(&self, dir: Vec3, value: f32, filter: DirectionalFilter) -> bool {
+    pub fn record(&self, dir: Vec3, value: f32, filter: DirectionalFilter) -> bool {
         if !(value >= 0.0 && value.is_finite()) {
             return false;
         }
@@ -47,7 +47,7 @@ impl DirectionalTree {
         match filter {
             DirectionalFilter::Nearest => self.sums.add(4 * n + q, value),
             DirectionalFilter::Box => {
-                self.splat_box(c, cell_size(level), value);
+                self.record_box(c, cell_size(level), value);
                 true
             }
         }
@@ -55,7 +55,7 @@ impl DirectionalTree {
 
     /// Spreads `value` over the square of side `size` centred on `c`,
     /// wrapped in `v` and clipped in `u` (see [`DirectionalFilter::Box`]).
-    fn splat_box(&self, c: Vec2, size: f64, value: f32) {
+    fn record_box(&self, c: Vec2, size: f64, value: f32) {
         let (cx, cy, h) = (c.x as f64, c.y as f64, 0.5 * size);
         let x0 = (cx - h).max(0.0);
         let x1 = (cx + h).min(1.0);

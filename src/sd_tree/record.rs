@@ -2,7 +2,7 @@
 
 use super::SdCell;
 use super::state::SdState;
-use super::validate::splat_value;
+use super::validate::record_value;
 use crate::dropped::DropReason;
 use crate::math::unit_direction;
 use crate::record::RecordOutcome;
@@ -14,7 +14,7 @@ use glam::Vec3;
 #[inline]
 fn check(dir: Vec3, radiance: f32, pdf: f32) -> Result<f32, DropReason> {
     unit_direction(dir).ok_or(DropReason::Direction)?;
-    splat_value(radiance, pdf)
+    record_value(radiance, pdf)
 }
 
 impl SdState {
