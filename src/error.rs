@@ -48,9 +48,12 @@ pub enum Error {
     Spatial(SpatialError),
     /// No light tree can be built from the emitters.
     Build(BuildError),
-    /// [`Strategy::new`](crate::Strategy::new) was given a name it does
-    /// not know.
-    UnknownStrategy,
+    /// A light sampling strategy was asked for by a name it does not
+    /// know (`Strategy::new`); `known` lists the names it does.
+    UnknownStrategy {
+        /// The names that are known.
+        known: &'static [&'static str],
+    },
     /// A guide was handed a light tree of another shape than the one it
     /// learned over ([`Glt::set_light_tree`](crate::Glt::set_light_tree)):
     /// other lights, another order, or a rebuild rather than a refit.
@@ -81,10 +84,9 @@ impl core::fmt::Display for Error {
             Self::Config(e) => e.fmt(f),
             Self::Spatial(e) => e.fmt(f),
             Self::Build(e) => e.fmt(f),
-            Self::UnknownStrategy => write!(
+            Self::UnknownStrategy { known } => write!(
                 f,
-                "unknown light sampling strategy (expected one of {:?})",
-                crate::Strategy::NAMES
+                "unknown light sampling strategy (expected one of {known:?})"
             ),
             Self::LightTreeShape => f.write_str(
                 "the light tree has another shape than the one the guide learned over \
@@ -101,7 +103,7 @@ impl std::error::Error for Error {
             Self::Config(e) => Some(e),
             Self::Spatial(e) => Some(e),
             Self::Build(e) => Some(e),
-            Self::UnknownStrategy | Self::LightTreeShape => None,
+            Self::UnknownStrategy { .. } | Self::LightTreeShape => None,
         }
     }
 }

@@ -50,7 +50,8 @@
 //! kernels, and the sampling rule over them in `f32`), `glt` and `field`
 //! (cuts in spatial trees), `schedule`, then
 //! for the integrator `strategy`, `path_recorder`, `mis`, `resampling` and
-//! `shared_guide`.
+//! `shared_guide`; last `config` and `learned`, the front's two small
+//! modules of re-exports. `tests/layers.rs` holds the code to this order.
 //!
 //! ## Where things are
 //!

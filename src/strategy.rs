@@ -73,7 +73,11 @@ impl Strategy {
                 config.cut.unbounded = unbounded;
                 Self::Glt(alloc::boxed::Box::new(Glt::new(tree()?, scene, config)?))
             }
-            _ => return Err(Error::UnknownStrategy),
+            _ => {
+                return Err(Error::UnknownStrategy {
+                    known: &Self::NAMES,
+                });
+            }
         })
     }
 

@@ -136,8 +136,16 @@ fn errors_are_typed() {
     let lights = two_rooms();
     assert_eq!(
         Strategy::new("bvh", &lights[..], NONE, scene()).unwrap_err(),
-        Error::UnknownStrategy
+        Error::UnknownStrategy {
+            known: &Strategy::NAMES
+        }
     );
+    let message = Strategy::new("bvh", &lights[..], NONE, scene())
+        .unwrap_err()
+        .to_string();
+    for name in Strategy::NAMES {
+        assert!(message.contains(name), "{message}");
+    }
     let bad = [Emitter::point(Vec3::ZERO, f32::NAN)];
     for name in ["importance", "glt"] {
         assert!(matches!(

@@ -111,7 +111,8 @@ pub struct CutConfig {
     /// above `sigma` is split (down to single emitters); slots at or below
     /// end the cut. Default 0.01, the paper's recommendation.
     pub sigma: f64,
-    /// Weight of the defensive mixture with the power prior:
+    /// Weight of the defensive mixture with the prior ([`CutConfig::prior`],
+    /// by default importance at the shading point):
     /// `pmf = (1 - alpha) * learned + alpha * prior`. Every emitter with
     /// non-zero power keeps a pmf of at least `alpha` times its prior pmf,
     /// so delta lights stay unbiased without MIS and the variance is never

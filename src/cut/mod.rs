@@ -7,7 +7,7 @@
 //!
 //! Where to find what:
 //! - [`CutRules`] (`cut_rules.rs`): what all cells share, the light
-//!   tree with its power prior precomputed and the [`CutConfig`]; every
+//!   tree with its power split precomputed (`split_table.rs`) and the [`CutConfig`]; every
 //!   operation on a cut goes through it;
 //! - [`GuidingCut`] (`guiding_cut.rs`): one cell's learned state, a weighted sub-tree
 //!   of the light tree from its root down to the cut, in two copies (sampled
@@ -17,6 +17,7 @@
 //!   light tree, mixed with the prior and the unbounded lights);
 //! - `walk.rs`: the light tree re-laid out for the sampling walk (both
 //!   children of a node in one 16-byte load);
+//! - `split_table.rs`: each inner node's power split in one signed `f32`;
 //! - `tables.rs`: a light tree's tables as the walks read them, and the
 //!   `Segment` a walk is in; `instanced_tables.rs`: those of an
 //!   [`crate::InstancedLightTree`], one set per mesh shared by its
@@ -38,7 +39,7 @@
 //! - `persist.rs`: a cut's and its configuration's saved bytes.
 //!
 //! How it differs from the paper's code (see the crate's reference notes):
-//! the initial cut is the power prior, not 0.5/0.5; a defensive mixture
+//! the initial cut is the power split, not 0.5/0.5; a defensive mixture
 //! with a prior (`alpha`, default 0.2) keeps every emitter with
 //! power at a non-zero pmf, so delta lights stay unbiased without MIS;
 //! cut nodes take 12 bytes, not 20; sums accumulate in `f64` or exactly,
@@ -63,6 +64,7 @@ mod persist;
 mod record;
 mod refine;
 mod sampling;
+mod split_table;
 mod tables;
 mod vertex;
 mod visibility;

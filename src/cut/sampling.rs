@@ -37,10 +37,11 @@
 
 use super::config::{BelowCut, CutConfig, Modulation, Prior};
 use super::cut_node::CutNode;
-use super::cut_rules::{CutRules, decode_split};
+use super::cut_rules::CutRules;
 use super::guiding_cut::{GuidingCut, sum_count};
 use super::importance_table::FastQuery;
 use super::instanced_tables::{InstancedTables, mesh_of};
+use super::split_table::decode_split;
 use super::tables::Segment;
 use super::walk::WalkNode;
 use crate::light_sampler::ShadingContext;

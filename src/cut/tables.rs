@@ -8,8 +8,8 @@
 //! segments: the top tree to an instance's leaf, then its mesh's tree with
 //! the point moved into mesh space.
 
-use super::cut_rules::encode_split;
 use super::importance_table::{FastQuery, ImportanceTable};
+use super::split_table::encode_split;
 use super::walk::{WalkNode, WalkTable};
 use crate::light_tree::LightHierarchy;
 use alloc::vec::Vec;

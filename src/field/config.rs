@@ -42,7 +42,7 @@ impl Default for FieldConfig {
 impl FieldConfig {
     /// Checks the SD-tree's ([`SdTreeConfig::validate`]) and the cuts'
     /// ([`CutConfig::validate`]) fields.
-    pub fn validate(&self) -> Result<(), crate::ConfigError> {
+    pub fn validate(&self) -> Result<(), crate::error::ConfigError> {
         self.sd.validate()?;
         self.cut.validate()
     }

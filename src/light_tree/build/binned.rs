@@ -1,10 +1,10 @@
 //! The binned split: 12 buckets per axis, all three axes in one pass over
 //! the items, the cheapest boundary by the heuristic's cost.
 
+use super::bucket::{Bucket, EMPTY_BUCKET};
 use super::heuristic::{BuildHeuristic, OrientationMemo, Weights, aspect};
 use super::items::Item;
-use crate::math::{Aabb, LightCone};
-use core::f32::consts::PI;
+use crate::math::Aabb;
 
 pub(super) const BUCKETS: usize = 12;
 
@@ -37,67 +37,6 @@ pub(super) fn bucket_of(it: &Item, centroids: &Aabb, axis: usize) -> usize {
     let t = (it.centroid[axis] - centroids.min[axis]) / (centroids.max[axis] - centroids.min[axis]);
     // `as u32` saturates like `as usize` (NaN -> 0) but converts cheaply.
     ((t * BUCKETS as f32) as u32 as usize).min(BUCKETS - 1)
-}
-
-/// The emitters of one bucket (or a run of buckets) on one axis. Under SAOH
-/// it also bounds their cones (meaningful when `count > 0`), carrying
-/// `theta_o` beside the cone so that `acos` is only taken when the cone
-/// changes.
-#[derive(Clone, Copy)]
-pub(super) struct Bucket {
-    pub(super) bounds: Aabb,
-    pub(super) area: f64,
-    pub(super) power: f64,
-    pub(super) count: usize,
-    pub(super) cone: LightCone,
-    pub(super) theta_o: f32,
-}
-
-pub(super) const EMPTY_BUCKET: Bucket = Bucket {
-    bounds: Aabb::EMPTY,
-    area: 0.0,
-    power: 0.0,
-    count: 0,
-    cone: LightCone::SPHERE,
-    theta_o: PI,
-};
-
-impl Bucket {
-    #[inline]
-    fn add<const SAOH: bool>(&mut self, it: &Item) {
-        if SAOH {
-            (self.cone, self.theta_o) = if self.count == 0 {
-                (it.cone, it.theta_o)
-            } else {
-                self.cone
-                    .union_with_angles(self.theta_o, &it.cone, it.theta_o)
-            };
-        }
-        self.count += 1;
-        self.bounds = self.bounds.union(&it.bounds);
-        self.area += it.area as f64;
-        self.power += it.power as f64;
-    }
-
-    #[inline]
-    fn merge<const SAOH: bool>(&self, o: &Bucket) -> Bucket {
-        let (cone, theta_o) = if !SAOH || o.count == 0 {
-            (self.cone, self.theta_o)
-        } else if self.count == 0 {
-            (o.cone, o.theta_o)
-        } else {
-            self.cone
-                .union_with_angles(self.theta_o, &o.cone, o.theta_o)
-        };
-        Bucket {
-            bounds: self.bounds.union(&o.bounds),
-            area: self.area + o.area,
-            power: self.power + o.power,
-            count: self.count + o.count,
-            cone,
-            theta_o,
-        }
-    }
 }
 
 /// The (axis, last left bucket) of the cheapest split, ties broken towards

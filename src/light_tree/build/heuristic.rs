@@ -1,7 +1,7 @@
 //! The build heuristics: which one to use ([`BuildHeuristic`]) and how each
 //! prices one side of a split.
 
-use super::binned::Bucket;
+use super::bucket::Bucket;
 use crate::math::scalar::{cos, safe_acos, sin_cos};
 use core::f32::consts::PI;
 use glam::Vec3;

@@ -5,6 +5,7 @@
 //! emitters move.
 
 mod binned;
+mod bucket;
 mod cone_bound;
 mod heuristic;
 mod items;
