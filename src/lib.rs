@@ -6,9 +6,14 @@
 //! - the lights and the shading point: [`Emitter`] (or your own
 //!   [`Emitters`]), [`LightTree`] ([`BuildHeuristic`]), [`ShadingContext`],
 //!   [`Aabb`];
-//! - choosing lights: the [`LightSampler`] trait ([`LightSample`],
-//!   [`LightId`]), the baselines by name ([`Strategy`]: uniform, power,
-//!   pbrt-v4's light BVH), the scene's sun and sky ([`UnboundedLights`]);
+//! - choosing lights: the [`LightSampler`] trait (pbrt-v4's
+//!   `sample(&ctx, u)` / `pmf(&ctx, light)`, [`LightSample`], [`LightId`]),
+//!   the baselines by name ([`Strategy`]: uniform, power, pbrt-v4's light
+//!   BVH), the scene's sun and sky ([`UnboundedLights`]); the
+//!   [`LightChoice`] trait for a choice fixed at one point (`sample(u)` /
+//!   `pmf(light)`: a guide's [`LightVertex`], any sampler's
+//!   [`SamplerAt`]), and `sample_with` beside every `u: f32` call for a
+//!   renderer holding a [`rand_core`] generator;
 //! - the guides: [`Glt`] (lights), [`SdTree`] (directions) and
 //!   [`GuidingField`] (both in one spatial tree), each with its
 //!   configuration ([`GltConfig`] and [`CutConfig`], [`SdTreeConfig`],
@@ -55,30 +60,10 @@
 //!
 //! ## Where things are
 //!
-//! | what | file |
-//! | --- | --- |
-//! | the GLT's sampling rule and pmf | `src/cut/sampling.rs` |
-//! | a path vertex's light choice and records (`LightVertex`) | `src/cut/vertex.rs` |
-//! | a path vertex's directional guiding and records (`DirectionVertex`) | `src/sd_tree/vertex.rs` |
-//! | the GLT's cells refining on their own records | `src/glt/cell.rs`, `src/glt/guiding_light_tree.rs` |
-//! | resampled light choice (candidates, reservoir, weight) | `src/resampling.rs` |
-//! | each cut cluster's learned visibility (the resampling target's factor) | `src/cut/visibility.rs` |
-//! | the light tree laid out for the GLT's walk | `src/cut/walk.rs` |
-//! | cut refinement (split / merge by sigma, `min_records`) | `src/cut/refine.rs` |
-//! | the tables every cut reads (`CutRules`) | `src/cut/cut_rules.rs` |
-//! | a path's radiance records | `src/path_recorder.rs` |
-//! | the save format and its checks | `src/persist/`, `docs/format.md` |
-//! | light-tree build heuristics | `src/light_tree/build/heuristic.rs` (the binned split: `build/binned.rs`) |
-//! | refitting the light tree to lights that moved, and when to rebuild | `src/light_tree/build/refit.rs` |
-//! | instanced emissive meshes (`InstancedLightTree`) | `src/light_tree/instanced.rs` |
-//! | the GLT's tables over instances, one set per mesh; the walk into an instance | `src/cut/instanced_tables.rs`, `src/cut/tables.rs` |
-//! | light linking in the GLT's walk (`Restriction`) | `src/cut/sampling.rs` |
-//! | the importance of a light cluster | `src/light_sampler/importance.rs` |
-//! | the same, from decoded nodes in `f32` (the GLT's importance rules) | `src/cut/importance_table.rs` |
-//! | the one-number descent | `src/math/descent.rs` |
-//! | a trained GLT as plain arrays for GPU kernels (`Glt::snapshot`), their layout | `src/snapshot/build.rs`, `src/snapshot/layout.rs` |
-//! | the GLT's sampling rule in `f32` over those arrays (the WGSL kernel's twin: `gpu/src/sample.wgsl`) | `src/snapshot/sampling.rs`, `src/snapshot/importance.rs` |
-//! | quadtree sampling and pdf | `src/quadtree/query.rs` |
+//! `ARCHITECTURE.md` at the repository's root maps each concept to its
+//! file (the GLT's sampling rule is `src/cut/sampling.rs`) and lists the
+//! options the crate rejected; docs/design.md gives each decision's
+//! reasons and measurements.
 //!
 //! ## Contracts
 //!

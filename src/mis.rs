@@ -66,7 +66,8 @@ pub enum Convention {
 ///   ([`LightVertex::record_light`](crate::LightVertex::record_light)):
 ///   `luminance(le) * factor` (or any
 ///   fixed scalar of `le`), whatever its visibility: an occluded sample
-///   records 0 (see the `schedule` module's rule on zero-valued records).
+///   records 0 (a zero is a valid record: it adds nothing to what is
+///   learned and counts as a sample for the split and refinement rules).
 ///
 /// Over the light choice and both samples, the values recorded for light
 /// `l` have as expectation the radiance it sends to the vertex (visibility
@@ -90,8 +91,9 @@ pub struct DirectEstimate {
     /// throughput): `f_cos * le * factor`, 0 when occluded.
     pub contribution: Vec3,
     /// The value to record for the light (`record_light`):
-    /// `luminance(le) * factor`, 0 when occluded (record it, or record
-    /// nothing: the schedule module's rule on zero-valued records).
+    /// `luminance(le) * factor`, 0 when occluded (record it: a zero adds
+    /// nothing to what is learned and counts as a sample for the split
+    /// and refinement rules; [`RecordOutcome::Zero`](crate::RecordOutcome::Zero)).
     pub record: f32,
 }
 

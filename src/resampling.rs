@@ -76,7 +76,7 @@
 //! density, `P(l) p_l` (any weights that sum to one over the strategies
 //! keep the combination unbiased): [`Resampled::pmf`] is that proxy's pmf,
 //! [`crate::mis::resampled_light_sample`] weighs the light sample under
-//! pbrt-v4's convention, and [`crate::mis::Convention::PbrtV4`]`.bsdf_sample`
+//! pbrt-v4's convention, and [`crate::Convention::PbrtV4`]`.bsdf_sample`
 //! the BSDF sample, with the pmf of the light it hit, as without
 //! resampling.
 

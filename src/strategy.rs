@@ -92,7 +92,7 @@ impl Strategy {
     }
 
     /// The GLT, to record through its vertices
-    /// ([`Glt::vertex`](crate::glt::Glt::vertex)); `None` for the
+    /// ([`Glt::vertex`](crate::Glt::vertex)); `None` for the
     /// strategies that do not learn. As a [`LightSampler`] the strategy
     /// looks the GLT's cell up on every query; a renderer that records
     /// locates the vertex once here and samples through it.

@@ -51,10 +51,10 @@ pub enum Modulation {
     /// constant distribution cannot. The factor keeps what the analytic
     /// bound misses (visibility, the BSDF). Where both importances at `x`
     /// are zero the step falls back to `r`. Records must carry their
-    /// position for the anchor ([`crate::glt::Glt`] and the combined field
-    /// do, [`crate::cut::CutRules::record_from`] does); a cut rebuilt
+    /// position for the anchor ([`crate::Glt`] and the combined field
+    /// do, [`crate::learned::CutRules::record_from`] does); a cut rebuilt
     /// without one (recorded only through
-    /// [`crate::cut::CutRules::record`]) keeps plain learned
+    /// [`crate::learned::CutRules::record`]) keeps plain learned
     /// probabilities. The initial cut has equal factors: it samples by the
     /// importance at the shading point until it has learned. The default.
     #[default]
@@ -149,7 +149,7 @@ pub struct CutConfig {
     /// whatever the thread count (48 bytes per sum instead of 8).
     pub accumulation: Accumulation,
     /// The fewest non-zero records a cut rebuilds from. Below it,
-    /// `CutRules::refine` keeps the cut as
+    /// [`CutRules::refine`](crate::learned::CutRules::refine) keeps the cut as
     /// it is and lets its sums go on accumulating into the next iteration:
     /// a light record is an unbiased estimate whatever distribution drew it,
     /// so sums from several iterations add up. Without this floor a cell
@@ -161,7 +161,7 @@ pub struct CutConfig {
     pub min_records: u32,
     /// Learn each cut cluster's visibility: the fraction of its unshadowed
     /// contribution that arrives, from next-event records that carry both
-    /// (`record_visibility` of [`crate::glt::Glt`], its vertex, the field and
+    /// (`record_visibility` of [`crate::Glt`], its vertex, the field and
     /// `CutRules::record_visibility`),
     /// shrunk towards what the cluster had before when it has few records
     /// and never below 1/64. It is the factor resampled light choice puts

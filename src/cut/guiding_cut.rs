@@ -205,7 +205,7 @@ impl GuidingCut {
     /// confidence times `20 s` (a tile-order renderer that has rendered
     /// only part of a cell leaves the other half at the prior, not at
     /// another region's choice). The crate's spatial structures set it
-    /// ([`Glt`](crate::glt::Glt), [`GuidingField`](crate::field::GuidingField));
+    /// ([`Glt`](crate::Glt), [`GuidingField`](crate::GuidingField));
     /// a cut used on its own keeps 1 unless
     /// [`GuidingCut::set_confidence`] says otherwise.
     #[inline]

@@ -90,7 +90,7 @@ impl<H: LightHierarchy> CutRules<H> {
     /// [`CutRules::record`] of an estimate made at the shading point
     /// `from`: with [`Modulation::Importance`] a record also adds
     /// `from` to the cut's anchor (the mean position its learned weights
-    /// come from). The cells of [`crate::glt::Glt`] and of the combined
+    /// come from). The cells of [`crate::Glt`] and of the combined
     /// field record this way.
     pub fn record_from(
         &self,

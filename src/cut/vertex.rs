@@ -14,8 +14,8 @@ use crate::record::RecordOutcome;
 use crate::spatial::{BinaryTree, CellId, Located, SpatialFilter, SpatialTree, record_offset};
 use glam::Vec3;
 
-/// Where a light vertex's records go: the cells of a [`Glt`](crate::glt::Glt)
-/// or of a [`GuidingField`](crate::field::GuidingField) (a stochastic filter may
+/// Where a light vertex's records go: the cells of a [`Glt`](crate::Glt)
+/// or of a [`GuidingField`](crate::GuidingField) (a stochastic filter may
 /// carry a record into a neighbouring cell), and their drop counter.
 pub(crate) trait LightCells {
     /// The GLT's record of the estimate `value` for `light` made at a
@@ -41,8 +41,8 @@ pub(crate) fn light_salt(light: LightId) -> [u32; 3] {
 }
 
 /// A path vertex's light choice: the cut of the cell of a
-/// [`Glt`](crate::glt::Glt) ([`Glt::vertex`](crate::glt::Glt::vertex)) or of a
-/// [`GuidingField`](crate::field::GuidingField)
+/// [`Glt`](crate::Glt) ([`Glt::vertex`](crate::Glt::vertex)) or of a
+/// [`GuidingField`](crate::GuidingField)
 /// ([`FieldVertex::light`](crate::FieldVertex::light)) found by the one
 /// lookup, sampled by the GLT's sampling rule (`src/cut/sampling.rs`), and
 /// the records that teach it.
@@ -116,7 +116,7 @@ impl<'a, H: LightHierarchy> LightVertex<'a, H> {
     /// the BSDF and the cosine (from NEE, `Le * T * w_mis / (pmf *
     /// pdf_solid_angle)`; from a BSDF sample that hit an emitter, `Le *
     /// w_mis / pdf_direction`; one scalar, e.g. luminance;
-    /// [`mis::DirectLight::estimate`](crate::mis::DirectLight::estimate)
+    /// [`mis::DirectLight::estimate`](crate::DirectLight::estimate)
     /// gives it). Occluded samples record 0 ([`RecordOutcome::Zero`]): a
     /// valid observation. It goes to the cut of the vertex's cell (or,
     /// with a jittering filter configured, of the cell at the jittered
@@ -181,7 +181,7 @@ impl<H: LightHierarchy> CutRules<H> {
     /// took its part ([`RecordOutcome::Recorded`] or
     /// [`RecordOutcome::Zero`]) counts it in the octant of its cell `p` lies
     /// in. A [`RecordOutcome::Dropped`] result is counted once. Shared by
-    /// [`Glt`](crate::glt::Glt) and the guiding field.
+    /// [`Glt`](crate::Glt) and the guiding field.
     #[inline]
     pub(crate) fn record_in_cells<C: AsRef<GuidingCut> + AsRef<OctantRecords>>(
         &self,

@@ -13,7 +13,7 @@ pub struct FieldCell {
     pub(super) sd: SdCell,
     pub(super) cut: GuidingCut,
     /// Light records since the last refinement per octant of the cell (as
-    /// [`GltCell`](crate::glt::GltCell) counts them).
+    /// [`GltCell`](crate::learned::GltCell) counts them).
     pub(super) octants: OctantRecords,
 }
 

@@ -22,7 +22,7 @@ pub struct FieldConfig {
     /// The spatial filter of light records
     /// ([`LightVertex::record_light`](crate::LightVertex::record_light)).
     /// Default [`SpatialFilter::Nearest`], as
-    /// [`GltConfig::light_filter`](crate::glt::GltConfig::light_filter): a
+    /// [`GltConfig::light_filter`](crate::GltConfig::light_filter): a
     /// jittered record carries light through walls into cells that cannot
     /// see it (measured in docs/experiments/light-selection.md, "The
     /// sealed dim room").

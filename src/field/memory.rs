@@ -18,8 +18,8 @@ pub struct FieldMemory {
     /// The cuts together. Their `inline_bytes` are already in
     /// `sd.spatial_bytes` and are not added again in the totals.
     pub cuts: CutMemory,
-    /// The [`CutRules`](crate::cut::CutRules)'s tables, shared by all
-    /// cells ([`CutRules::bytes`](crate::cut::CutRules::bytes)).
+    /// The [`CutRules`](crate::learned::CutRules)'s tables, shared by all
+    /// cells ([`CutRules::bytes`](crate::learned::CutRules::bytes)).
     pub shared_bytes: usize,
 }
 
@@ -29,7 +29,7 @@ impl FieldMemory {
         self.capped() + self.shared_bytes
     }
 
-    /// What [`SdTreeConfig::max_bytes`](crate::sd_tree::SdTreeConfig::max_bytes)
+    /// What [`SdTreeConfig::max_bytes`](crate::SdTreeConfig::max_bytes)
     /// caps: everything but the shared table.
     pub fn capped(&self) -> usize {
         self.sd.total() + self.cut_bytes()

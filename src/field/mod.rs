@@ -222,9 +222,9 @@ impl<H: LightHierarchy> GuidingField<H> {
 
     /// Radiance and fraction records dropped for bad input so far, per
     /// reason: radiance records and fraction records as
-    /// [`SdTree::dropped_records`](crate::sd_tree::SdTree::dropped_records)
+    /// [`SdTree::dropped_records`](crate::SdTree::dropped_records)
     /// counts them, light records in [`DroppedRecords::light`] (as
-    /// [`Glt::dropped_records`](crate::glt::Glt::dropped_records)).
+    /// [`Glt::dropped_records`](crate::Glt::dropped_records)).
     pub fn dropped_records(&self) -> DroppedRecords {
         self.sd.dropped.snapshot()
     }

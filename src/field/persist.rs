@@ -74,7 +74,7 @@ impl<H: LightHierarchy> GuidingField<H> {
     }
 
     /// Adds what `other` recorded to this field, with the protocol of
-    /// [`Glt::merge`](crate::glt::Glt::merge) (workers start from the
+    /// [`Glt::merge`](crate::Glt::merge) (workers start from the
     /// coordinator's state after [`GuidingField::clear_records`]): both
     /// must be copies of one field after the same refinements, else
     /// nothing changes and this is `false`. Deterministic mode merges bit

@@ -16,8 +16,8 @@ pub struct GltMemory {
     /// the inline [`GltCell`](super::GltCell) values (which include the cuts' inline parts,
     /// so those are not added twice in [`GltMemory::total`]).
     pub spatial_bytes: usize,
-    /// The [`CutRules`](crate::cut::CutRules)'s tables, shared by all
-    /// cells ([`CutRules::bytes`](crate::cut::CutRules::bytes)).
+    /// The [`CutRules`](crate::learned::CutRules)'s tables, shared by all
+    /// cells ([`CutRules::bytes`](crate::learned::CutRules::bytes)).
     pub shared_bytes: usize,
 }
 

@@ -119,13 +119,13 @@ impl<H: LightHierarchy> Glt<H> {
     /// coordinator sends its state; each worker loads it, calls
     /// [`Glt::clear_records`] (so its share holds only its own records,
     /// not the coordinator's, which may carry sums a cut below
-    /// [`CutConfig::min_records`](crate::cut::CutConfig::min_records) keeps from
+    /// [`CutConfig::min_records`](crate::CutConfig::min_records) keeps from
     /// earlier iterations), records, and sends the share back; the
     /// coordinator merges every share into its state and refines. Both
     /// must have the same light hierarchy, configuration, spatial tree and
     /// cuts (copies of one GLT after the same refinements); otherwise
     /// nothing changes and this is `false`. In
-    /// [`Accumulation::Deterministic`](crate::math::Accumulation::Deterministic)
+    /// [`Accumulation::Deterministic`](crate::Accumulation::Deterministic)
     /// the merged state is bit for bit what one GLT recording all the
     /// workers' records would hold (`tests/merge.rs`, `examples/render/src/bin/farm.rs`).
     pub fn merge(&mut self, other: &Self) -> bool {

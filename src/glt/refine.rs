@@ -8,24 +8,25 @@ use crate::spatial::{Growth, RefineOutcome, content_scale};
 impl<H: LightHierarchy> Glt<H> {
     /// Turns what was recorded into the cuts sampled next, cell by cell
     /// (`&mut self`: between passes or tiles, or through
-    /// [`SharedGuide`](crate::shared_guide::SharedGuide)).
+    /// [`SharedGuide`](crate::SharedGuide)).
     ///
     /// A cell takes part once it holds 3/2 of the records that fell in it
     /// before its last refinement (any, before its first; see
-    /// `GltCell`); the others
+    /// [`GltCell`](crate::learned::GltCell)); the others
     /// keep accumulating. A cell that takes part splits while its count is
     /// above `c sqrt(2^g)` (`c` the spatial threshold, `g` the refinements
     /// it took part in, a half taken to have half its parent's records: PPG's
     /// rule, with the cell's own clock); both halves get a copy of the cut
     /// and its sums, and each the confidence of its share of the records
-    /// (`GuidingCut::confidence`). Then its cut is rebuilt from its sums
-    /// (`CutRules::refine`; a cut that collected nothing keeps its
+    /// ([`GuidingCut::confidence`](crate::learned::GuidingCut::confidence)).
+    /// Then its cut is rebuilt from its sums
+    /// ([`CutRules::refine`](crate::learned::CutRules::refine); a cut that collected nothing keeps its
     /// distribution) within the memory budget. A renderer that refines
     /// after every iteration of PPG's doubling schedule makes every cell
     /// take part every time; one that renders tile by tile may refine
     /// after every few tiles. Returns what the spatial refinement did, as
-    /// [`SdTree::refine`](crate::sd_tree::SdTree::refine) and
-    /// [`GuidingField::refine`](crate::field::GuidingField::refine) do.
+    /// [`SdTree::refine`](crate::SdTree::refine) and
+    /// [`GuidingField::refine`](crate::GuidingField::refine) do.
     pub fn refine(&mut self) -> RefineOutcome {
         for cell in self.spatial.data_slice_mut() {
             cell.begin();

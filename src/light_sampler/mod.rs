@@ -151,7 +151,7 @@ pub trait LightSampler {
     /// fraction of its unshadowed contribution that arrives, in
     /// `[1/64, 1]`. Resampled light choice (`crate::resampling`) puts it
     /// on its target. 1 for samplers that learn none (the default), and
-    /// for the GLT unless [`crate::cut::CutConfig::visibility`] is on.
+    /// for the GLT unless [`crate::CutConfig::visibility`] is on.
     fn visibility(&self, _ctx: &ShadingContext, _light: LightId) -> f32 {
         1.0
     }

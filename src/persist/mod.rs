@@ -1,7 +1,7 @@
 //! Saving and loading what was learned, and the light tree it refers to:
 //! `to_bytes` / `from_bytes` on [`LightTree`](crate::LightTree),
-//! [`SdTree`](crate::sd_tree::SdTree), [`Glt`](crate::glt::Glt) and
-//! [`GuidingField`](crate::field::GuidingField), over byte slices (no
+//! [`SdTree`](crate::SdTree), [`Glt`](crate::Glt) and
+//! [`GuidingField`](crate::GuidingField), over byte slices (no
 //! `std` needed); with `std`, `read_from` and `write_to` move them through
 //! `std::io` streams without trusting a length in the stream.
 //!
@@ -64,10 +64,10 @@ pub const FORMAT_VERSION: u32 = bytes::FORMAT_VERSION;
 pub enum Kind {
     /// A [`LightTree`](crate::LightTree).
     LightTree = 1,
-    /// An [`SdTree`](crate::sd_tree::SdTree).
+    /// An [`SdTree`](crate::SdTree).
     SdTree = 2,
-    /// A [`Glt`](crate::glt::Glt).
+    /// A [`Glt`](crate::Glt).
     Glt = 3,
-    /// A [`GuidingField`](crate::field::GuidingField).
+    /// A [`GuidingField`](crate::GuidingField).
     Field = 4,
 }

@@ -8,7 +8,7 @@
 //! - the *building* copy collects [`DirectionalTree::record`]s from many
 //!   threads through `&self` into thread-safe sums (`src/math/sum.rs`)
 //!   (lock-free, no lost update, no `f32` accumulation error, bit-identical in
-//!   [`Accumulation::Deterministic`](crate::math::Accumulation) mode).
+//!   [`Accumulation::Deterministic`](crate::Accumulation) mode).
 //!
 //! [`DirectionalTree::refine`] turns the building copy's sums into the next
 //! sampling copy, then refines the building topology for the next iteration.

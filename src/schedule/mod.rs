@@ -46,11 +46,11 @@
 //! all of a tile's samples, tile after tile) has no rounds: it records as
 //! it goes and calls `refine()` after every few tiles (a wave of as many
 //! tiles as it has threads, say). The GLT refines cell by cell
-//! (`glt::GltCell`): a cell takes part once it holds 3/2 of the records
+//! ([`GltCell`](crate::learned::GltCell)): a cell takes part once it holds 3/2 of the records
 //! that fell in it before its last refinement, so the cells the tiles
 //! have reached learn while the others wait for records of their own, and
 //! a half of a cell that the records never reached falls back to the prior
-//! (`glt::GuidingCut::confidence`) instead of sampling with a choice
+//! ([`GuidingCut::confidence`](crate::learned::GuidingCut::confidence)) instead of sampling with a choice
 //! learned elsewhere. (The field's cells refine on PPG's clock, every
 //! refinement, as its SD-tree needs; their halves fall back to the prior
 //! as the GLT's do.)

@@ -1,6 +1,6 @@
 //! The SD-tree of Practical Path Guiding (Müller et al. 2017): a spatial
 //! binary tree ([`BinaryTree`]) whose cells ([`SdCell`]) hold directional
-//! quadtrees ([`DirectionalTree`](crate::quadtree::DirectionalTree)).
+//! quadtrees ([`DirectionalTree`](crate::learned::DirectionalTree)).
 //!
 //! A renderer, at each path vertex, locates it once ([`SdTree::vertex`]) and
 //! through the [`DirectionVertex`]:

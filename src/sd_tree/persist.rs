@@ -165,7 +165,7 @@ impl SdTree {
     }
 
     /// Adds what `other` recorded to this SD-tree, with the protocol of
-    /// [`Glt::merge`](crate::glt::Glt::merge) (workers start from the
+    /// [`Glt::merge`](crate::Glt::merge) (workers start from the
     /// coordinator's state after [`SdTree::clear_records`]): both must be
     /// copies of one SD-tree after the same refinements, else nothing
     /// changes and this is `false`.

@@ -10,7 +10,7 @@ use crate::spatial::{CellId, Located, SpatialTree};
 use glam::Vec3;
 
 /// Where a direction vertex's radiance records go: the cells of an
-/// [`SdTree`] or of a [`GuidingField`](crate::field::GuidingField) (the spatial
+/// [`SdTree`] or of a [`GuidingField`](crate::GuidingField) (the spatial
 /// filters may reach the neighbouring cells).
 pub(crate) trait RadianceCells {
     /// PPG's record from a located point, with the configured filters.
@@ -26,7 +26,7 @@ impl RadianceCells for SdTree {
 }
 
 /// A path vertex's directional guiding: the cell of an [`SdTree`]
-/// ([`SdTree::vertex`]) or of a [`GuidingField`](crate::field::GuidingField)
+/// ([`SdTree::vertex`]) or of a [`GuidingField`](crate::GuidingField)
 /// ([`FieldVertex::direction`](crate::FieldVertex::direction)) found by the
 /// one lookup, through which the guided direction, its pdf, the BSDF
 /// fraction and both records at that point go.

@@ -65,7 +65,7 @@ pub struct Header {
     pub root_max: [f32; 3],
     /// Number of [`Cell`]s.
     pub cells: u32,
-    /// Number of [`CutNode`](crate::cut::CutNode)-layout records (12
+    /// Number of [`CutNode`](crate::learned::CutNode)-layout records (12
     /// bytes: `p_left: f32`, two slot words), all cells' cuts end to end.
     pub cut_nodes: u32,
     /// Number of [`TreePair`]s (pair 0 holds the light tree's root; an

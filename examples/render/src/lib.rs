@@ -9,12 +9,17 @@
 //! One concept per file: `cli` (flags), `scenes/` (scene generators),
 //! `scene` (scene container, effect declarations), `geometry` + `bvh`
 //! (primitives, obvhs ray casting), `materials`, `lights`, `camera`,
-//! `integrator` (the path tracer and its training records), `methods`
-//! (which crate objects a method uses), `run` (passes, training schedule,
-//! combination), `film` (EXR/PNG), `reference` (cache), `metrics`,
-//! `report` (JSON, table), `sheet` (comparison sheet), `shading_points`
-//! (the first non-specular vertices of camera paths), `animation` and
-//! `frames` (an animated scene and its frames rendered three ways).
+//! `rng` (a PCG stream per seed, pass and tile), `integrator` (the path
+//! tracer and its training records), `methods` (which crate objects a
+//! method uses), `run` (passes, training schedule, combination), `tiles`
+//! (pbrt-v3's tile order), `film` (EXR/PNG), `reference` (cache),
+//! `metrics`, `report` (JSON records, tables), `json` (reading them back
+//! for `--replot`), `crossing` (when a guided curve stays below its
+//! counterpart's), `plot` (convergence plots), `sheet` (comparison
+//! sheet), `raster` + `text` (the canvas and the font both draw with),
+//! `shading_points` (the first non-specular vertices of camera paths),
+//! `animation` and `frames` (an animated scene and its frames rendered
+//! three ways).
 #![allow(missing_docs)]
 
 pub mod animation;
