@@ -91,7 +91,7 @@
 //! | what a light sample records ([`LightVertex::record_light`]) | [`luminance`]`(Le) * factor` with the [`DirectLight`] factor of its convention: the light's arriving radiance, not times the BSDF and cosine, MIS-weighted and divided by the pdf; [`DirectLight::estimate`] gives the contribution and the record from one call, for pbrt-v4's or pbrt-v3's convention ([`Convention`]) |
 //! | random numbers for a record | none: the stochastic box filter (off by default for light records) takes its offset from a hash of the record (`src/spatial/jitter.rs`), so the same records learn the same state on any thread count |
 //! | an occluded sample, a light behind the surface, a BSDF that is zero (and the shadow ray skipped) | record 0 or nothing, never a shadow ray for the record's sake: a zero adds nothing to what is learned; it only counts as a sample for the split and refinement rules, which then follow where paths go rather than where light arrives |
-//! | when to call `refine` | after each of PPG's doubling iterations ([`Iterations`]); a renderer that renders each tile to completion, after every wave of tiles (as many as it has threads): a GLT cell refines once it holds 3/2 of its records before ([`Glt::refine`]) |
+//! | when to call `refine` | after each of PPG's doubling iterations ([`Iterations`]); a renderer that renders tiles from a work queue with no tile hook or thread count (pbrt-v3, rs_pbrt): share the guide in a [`SharedGuide`], take its guard per path and call [`SharedGuide::refine_when_due`] after each; the GLT then refines whenever that costs under 2% of the time ([`RefineSchedule::GLT`]), each cell once it holds 3/2 of its records before ([`Glt::refine`]) |
 //! | lights that moved or changed power since the last frame (same lights, same order) | [`LightTree::refit`] the guide's tree, then hand it over ([`Glt::set_light_tree`], [`GuidingField::set_light_tree`]): what was learned is kept and every cell refines on the new frame's records; when the refit's drift passes [`LightTree::REBUILD_RATIO`], build a new tree and guide instead. A saved guide loads over any refit of its tree (docs/format.md) |
 //! | an object lit by some lights only (light linking) | the emitters' sets ([`Emitter::in_light_sets`], [`Emitters::light_sets`], up to 64) and the point's ([`ShadingContext::lit_by`]); unbounded lights by a per-point mask ([`ShadingContext::lit_by_unbounded`]). Every sampler renormalises exactly over what the point is lit by; with a GLT, keep one per receiver set over the shared tree (measured better than one masked GLT, docs/experiments/light-sets.md) |
 //! | many instances of one emissive mesh | one [`LightTree`] per mesh in mesh space, the instances as [`Instance`]s, one [`InstancedLightTree`] (a [`LightHierarchy`] every sampler and the GLT take); emitter ids through [`InstancedLightTree::emitter_id`] and [`InstancedLightTree::locate`] |
@@ -247,7 +247,7 @@ pub use record::RecordOutcome;
 pub use resampling::{BsdfCandidate, Evaluated, Resampled, resample};
 pub use schedule::{InverseVarianceCombiner, Iteration, Iterations, PassStats};
 #[cfg(feature = "std")]
-pub use shared_guide::{Refine, SharedGuide};
+pub use shared_guide::{Refine, RefineSchedule, SharedGuide};
 // Errors.
 pub use error::{ConfigError, Error};
 pub use persist::LoadError;

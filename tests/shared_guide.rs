@@ -13,8 +13,8 @@ use guiding::cut::CutConfig;
 use guiding::glt::{Glt, GltConfig};
 use guiding::light_tree::BuildHeuristic;
 use guiding::math::Accumulation;
-use guiding::shared_guide::SharedGuide;
-use guiding::{LightId, LightSampler, LightTree, ShadingContext};
+use guiding::shared_guide::{RefineSchedule, SharedGuide};
+use guiding::{LightChoice, LightId, LightSampler, LightTree, ShadingContext};
 use std::sync::Barrier;
 
 fn config() -> GltConfig {
@@ -165,5 +165,111 @@ fn refinements_in_the_middle_of_a_render_keep_the_contracts() {
         assert!((total - 1.0).abs() < 1e-6);
         let x = ByPosition(&*glt).sample(&ctx, rng.f()).unwrap();
         assert_eq!(x.pmf, ByPosition(&*glt).pmf(&ctx, x.light));
+    }
+}
+
+/// PPG's doubling through `refine_when_due`: the refinements run after
+/// exactly `first`, `3 first`, `7 first` paths, counted however the calls
+/// group them. Control: a schedule that doubled the total instead (after
+/// `first`, `2 first`, `4 first`) refines at 200 paths and fails here.
+#[test]
+fn doubling_refines_after_first_three_and_seven_times_first() {
+    let tree = LightTree::build(&two_rooms(), BuildHeuristic::Sarh).unwrap();
+    let glt = Glt::new(&tree, scene(), config()).unwrap();
+    let schedule = RefineSchedule::Doubling { first: 100 };
+    let shared = SharedGuide::with_schedule(glt, schedule).unwrap();
+    assert_eq!(shared.schedule(), schedule);
+    let mut ran = Vec::new();
+    for path in 1..=800u64 {
+        // A tile of 4 paths every 50 paths, single paths between.
+        let n = if path % 50 == 0 { 4 } else { 1 };
+        if shared.refine_when_due(n).is_some() {
+            ran.push(path);
+        }
+    }
+    let counted: Vec<u64> = ran.iter().map(|&p| p + 3 * (p / 50)).collect();
+    assert_eq!(counted, [100, 300, 700], "paths counted at each refinement");
+    assert_eq!(shared.refinements(), 3);
+}
+
+/// The amortized schedule refines at the first call (nothing took any
+/// time yet), then waits `ratio` times what that refinement took; an
+/// explicit `refine` counts too. Control: with the clock not updated after
+/// a refinement, the second call refines again and this fails.
+#[test]
+fn amortized_waits_ratio_times_the_last_refinement() {
+    let tree = LightTree::build(&two_rooms(), BuildHeuristic::Sarh).unwrap();
+    let glt = Glt::new(&tree, scene(), config()).unwrap();
+    let lazy = RefineSchedule::Amortized { ratio: u32::MAX };
+    let shared = SharedGuide::with_schedule(glt, lazy).unwrap();
+    assert!(shared.refine_when_due(1).is_some());
+    for _ in 0..1000 {
+        assert!(shared.refine_when_due(1).is_none());
+    }
+    assert_eq!(shared.refinements(), 1);
+    // The GLT's own default, and the others' doubling from their threshold.
+    let glt = Glt::new(&tree, scene(), config()).unwrap();
+    assert_eq!(SharedGuide::new(glt).schedule(), RefineSchedule::GLT);
+    let sd = guiding::SdTree::new(scene(), Default::default()).unwrap();
+    assert_eq!(
+        SharedGuide::new(sd).schedule(),
+        RefineSchedule::Doubling { first: 12_000 }
+    );
+}
+
+/// A schedule that could never refine, or would refine at every call
+/// forever, is a configuration error.
+#[test]
+fn invalid_schedules_are_errors() {
+    let tree = LightTree::build(&two_rooms(), BuildHeuristic::Sarh).unwrap();
+    for bad in [
+        RefineSchedule::Amortized { ratio: 0 },
+        RefineSchedule::Doubling { first: 0 },
+    ] {
+        let glt = Glt::new(&tree, scene(), config()).unwrap();
+        let e = SharedGuide::with_schedule(glt, bad).unwrap_err();
+        assert!(matches!(e, guiding::Error::Config(_)), "{e}");
+        assert!(e.to_string().contains("at least 1"), "{e}");
+    }
+}
+
+/// Four threads hold the guard per path and call `refine_when_due` after
+/// each, as a renderer with tiles from a queue does: no deadlock, the GLT
+/// refines, and its distributions keep their contracts.
+#[test]
+fn refining_when_due_from_every_path() {
+    let lights = two_rooms();
+    let tree = LightTree::build(&lights, BuildHeuristic::Sarh).unwrap();
+    let shared = SharedGuide::new(Glt::new(&tree, scene(), config()).unwrap());
+    std::thread::scope(|s| {
+        for t in 0..4u64 {
+            let (shared, lights) = (&shared, &lights);
+            s.spawn(move || {
+                let mut rng = Rand::new(300 + t);
+                for _ in 0..3000 {
+                    let glt = shared.read();
+                    let p = rng.point(9.5);
+                    let ctx = ShadingContext::at(p);
+                    let v = glt.vertex(&ctx).unwrap();
+                    let x = v.sample(rng.f()).unwrap();
+                    let LightId::Emitter(e) = x.light else {
+                        panic!("no unbounded lights")
+                    };
+                    v.record_light(x.light, value(lights, e, p) / x.pmf);
+                    drop(glt);
+                    shared.refine_when_due(1);
+                }
+            });
+        }
+    });
+    assert!(shared.refinements() >= 2, "{}", shared.refinements());
+    let glt = shared.read();
+    let mut rng = Rand::new(8);
+    for _ in 0..50 {
+        let ctx = ShadingContext::at(rng.point(9.0));
+        let total: f64 = (0..80)
+            .map(|e| ByPosition(&*glt).pmf_exact(&ctx, LightId::Emitter(e)))
+            .sum();
+        assert!((total - 1.0).abs() < 1e-6);
     }
 }

@@ -53,7 +53,7 @@ impl FieldMemory {
 
     /// The same for the sampled copies alone: cut nodes
     /// ([`CutNode::BYTES`] each) against sampling quadtree nodes
-    /// ([`NODE_BYTES`] each), what queries read.
+    /// (`NODE_BYTES` each, the quadtree's node size), what queries read.
     pub fn sampled_cut_to_quadtree(&self) -> f64 {
         let cuts = self.cuts.nodes * CutNode::BYTES;
         let quadtrees = self.sd.quadtree_nodes * NODE_BYTES;

@@ -9,7 +9,7 @@ use crate::light_tree::LightHierarchy;
 use crate::math::Descent;
 
 /// Descends a [`LightHierarchy`] choosing, at each inner node, between the
-/// two children in proportion to their [`super::importance()`] at the shading
+/// two children in proportion to their importance (`light_sampler::importance`) at the shading
 /// point: power x orientation bound / clamped distance^2, x the normal bound
 /// when the context has a normal.
 ///

@@ -23,6 +23,13 @@ impl Counter {
         self.0.fetch_add(1, Relaxed);
     }
 
+    /// Adds `n` (wrapped to 32 bits where the counter is).
+    #[inline]
+    pub fn add(&self, n: u64) {
+        #[allow(clippy::useless_conversion, clippy::unnecessary_cast)]
+        self.0.fetch_add(n as _, Relaxed);
+    }
+
     /// The count so far.
     #[inline]
     pub fn get(&self) -> u64 {

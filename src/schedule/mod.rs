@@ -43,9 +43,14 @@
 //! there to save their cost.
 //!
 //! A renderer that renders each tile to completion (pbrt-v3, rs_pbrt:
-//! all of a tile's samples, tile after tile) has no rounds: it records as
-//! it goes and calls `refine()` after every few tiles (a wave of as many
-//! tiles as it has threads, say). The GLT refines cell by cell
+//! all of a tile's samples, tile after tile, from a work queue) has no
+//! rounds and often no tile hook: it shares the guide in a
+//! [`SharedGuide`](crate::SharedGuide), records as it goes and calls
+//! [`SharedGuide::refine_when_due`](crate::SharedGuide::refine_when_due)
+//! after every path, which refines the GLT whenever the refinement's cost
+//! is amortized ([`RefineSchedule::GLT`](crate::RefineSchedule::GLT)).
+//! That beats refining after every wave of tiles (rs_pbrt's rooms and
+//! street, docs/experiments/tile-order.md). The GLT refines cell by cell
 //! ([`GltCell`](crate::learned::GltCell)): a cell takes part once it holds 3/2 of the records
 //! that fell in it before its last refinement, so the cells the tiles
 //! have reached learn while the others wait for records of their own, and

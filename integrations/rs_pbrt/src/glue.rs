@@ -69,20 +69,46 @@ impl GltStrategy {
     }
 }
 
+impl GltStrategy {
+    /// The GLT (for a tile renderer's threads to share through a
+    /// [`SharedGuide`](guiding::SharedGuide)), and how many of the scene's lights are emitters.
+    pub fn into_parts(self) -> (Glt<LightTree>, u32) {
+        (self.0, self.1)
+    }
+}
+
+/// The GLT through a borrow (a [`SharedGuide`](guiding::SharedGuide)'s read guard).
+pub struct GltRef<'g>(pub &'g Glt<LightTree>, pub u32);
+
 /// The GLT's view from one shading point: its vertex (one lookup; it
 /// keeps the context).
 pub struct GltAt<'a>(Option<LightVertex<'a, LightTree>>, u32);
+
+fn glt_at<'a>(glt: &'a Glt<LightTree>, emitters: u32, it: &SurfaceInteraction) -> GltAt<'a> {
+    let ctx = ShadingContext::facing(v!(it.common.p), v!(it.shading.n), v!(it.common.wo));
+    GltAt(glt.vertex(&ctx), emitters)
+}
 
 impl LightStrategy for GltStrategy {
     type At<'a> = GltAt<'a>;
 
     fn at<'a>(&'a self, it: &SurfaceInteraction) -> GltAt<'a> {
-        let ctx = ShadingContext::facing(v!(it.common.p), v!(it.shading.n), v!(it.common.wo));
-        GltAt(self.0.vertex(&ctx), self.1)
+        glt_at(&self.0, self.1, it)
     }
 
     fn refine(&mut self) {
         self.0.refine();
+    }
+}
+
+impl LightStrategy for GltRef<'_> {
+    type At<'a>
+        = GltAt<'a>
+    where
+        Self: 'a;
+
+    fn at<'a>(&'a self, it: &SurfaceInteraction) -> GltAt<'a> {
+        glt_at(self.0, self.1, it)
     }
 }
 

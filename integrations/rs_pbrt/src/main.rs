@@ -6,11 +6,17 @@
 //! cargo run --release                      # every scene, every strategy
 //! cargo run --release -- --scene two_rooms --spp 16
 //! cargo run --release -- --check           # CI: a tiny scene in seconds
+//! cargo run --release -- --scene two_rooms --tiles never,waves,auto --seeds 3
 //! ```
+//!
+//! `--tiles` renders the GLT in tile order instead (src/tiles.rs: threads
+//! take tiles from a queue, a `SharedGuide` guard per path) with each
+//! learning rule, and prints relMSE against the reference.
 
 mod glue;
 mod path_tracer;
 mod scene_file;
+mod tiles;
 
 use guiding::glam::Vec3;
 use guiding::luminance;
@@ -32,6 +38,9 @@ struct Options {
     max_seconds: f64,
     check: bool,
     out: PathBuf,
+    /// Learning rules to compare in tile order (`--tiles`), if any.
+    tiles: Vec<String>,
+    seeds: u64,
 }
 
 fn options() -> Result<Options, String> {
@@ -46,6 +55,8 @@ fn options() -> Result<Options, String> {
         max_seconds: 600.0,
         check: false,
         out: here.join("out"),
+        tiles: Vec::new(),
+        seeds: 1,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -69,6 +80,13 @@ fn options() -> Result<Options, String> {
                     .map_err(|e| format!("--max-seconds: {e}"))?
             }
             "--out" => o.out = value()?.into(),
+            "--tiles" => {
+                o.tiles = match value()?.as_str() {
+                    "all" => tiles::LEARNING.map(String::from).to_vec(),
+                    v => v.split(',').map(String::from).collect(),
+                }
+            }
+            "--seeds" => o.seeds = value()?.parse().map_err(|e| format!("--seeds: {e}"))?,
             "--check" => o.check = true,
             _ => return Err(format!("unknown argument {a}")),
         }
@@ -258,6 +276,37 @@ fn reference(loaded: &Loaded, scene: &str, o: &Options) -> Result<Vec<Vec3>, Str
     Ok(pixels)
 }
 
+/// The GLT in tile order with each learning rule of `--tiles`, against
+/// the reference: relMSE at equal samples, seconds, refinements.
+fn compare_tiles(loaded: &Loaded, reference: &[Vec3], spp: u32, o: &Options) -> Result<(), String> {
+    println!("\n| learning (tile order) | seeds | relMSE | vs never | seconds | refinements |");
+    println!("|---|---:|---:|---:|---:|---:|");
+    let mut never = None;
+    for rule in &o.tiles {
+        let (mut err, mut secs, mut refs) = (0.0, 0.0, 0);
+        for seed in 0..o.seeds {
+            let (glt, emitters) = glue::GltStrategy::new(&loaded.scene)
+                .map_err(|e| e.to_string())?
+                .into_parts();
+            let guide = tiles::guide(glt, rule)?;
+            let run = tiles::render_tiles(loaded, &guide, emitters, spp, 7 + seed, rule)?;
+            err += rel_mse(&run.image.pixels(), reference) / o.seeds as f64;
+            secs += run.seconds / o.seeds as f64;
+            refs += run.refinements;
+        }
+        if rule == "never" {
+            never = Some(err);
+        }
+        let ratio = never.map_or("-".into(), |n| format!("{:.2}x", n / err));
+        println!(
+            "| {rule} | {} | {err:.4} | {ratio} | {secs:.2} | {:.1} |",
+            o.seeds,
+            refs as f64 / o.seeds as f64
+        );
+    }
+    Ok(())
+}
+
 fn compare(scene: &str, o: &Options) -> Result<(), String> {
     let file = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("scenes")
@@ -281,6 +330,9 @@ fn compare(scene: &str, o: &Options) -> Result<(), String> {
     );
     let reference = reference(&loaded, scene, o)?;
     let reference_mean = mean(&reference);
+    if !o.tiles.is_empty() {
+        return compare_tiles(&loaded, &reference, spp, o);
+    }
     let mut runs = Vec::new();
     for s in &o.strategies {
         let run = render(
@@ -354,6 +406,17 @@ fn check(spp: u32) -> Result<(), String> {
             Ok((*s, r.pixels.as_deref().map_or(f64::NAN, mean)))
         })
         .collect::<Result<_, String>>()?;
+    // The GLT in tile order, refining when due (src/tiles.rs).
+    let (glt, emitters) = glue::GltStrategy::new(&loaded.scene)
+        .map_err(|e| e.to_string())?
+        .into_parts();
+    let guide = tiles::guide(glt, "auto")?;
+    let run = tiles::render_tiles(&loaded, &guide, emitters, spp, 0, "auto")?;
+    if run.refinements == 0 {
+        return Err("tile order: the GLT never refined".into());
+    }
+    let mut means = means;
+    means.push(("glt in tile order", mean(&run.image.pixels())));
     let all = means.iter().map(|m| m.1).sum::<f64>() / means.len() as f64;
     for (s, m) in &means {
         println!("{s}: mean {m:.4}");

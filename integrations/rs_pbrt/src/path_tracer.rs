@@ -190,7 +190,7 @@ fn direct(loaded: &Loaded, it: &SurfaceInteraction, at: &impl LightAt, rng: &mut
 
 /// The radiance along the camera ray `ray` (pbrt-v3's path tracer, at most
 /// `max_depth` bounces).
-fn radiance(
+pub fn radiance(
     loaded: &Loaded,
     strategy: &impl LightStrategy,
     ray: Ray,
@@ -251,6 +251,34 @@ fn radiance(
     if l.is_finite() { l } else { Vec3::ZERO }
 }
 
+/// One camera sample of pixel `(x, y)`: its ray's radiance times the
+/// camera's weight.
+pub fn sample_pixel(
+    loaded: &Loaded,
+    strategy: &impl LightStrategy,
+    (x, y): (usize, usize),
+    rng: &mut Rng,
+) -> Vec3 {
+    let sample = CameraSample {
+        p_film: Point2f {
+            x: x as f32 + rng.f32(),
+            y: y as f32 + rng.f32(),
+        },
+        p_lens: rng.p2(),
+        time: 0.0,
+    };
+    let mut ray = Ray {
+        t_max: Cell::new(f32::INFINITY),
+        ..Default::default()
+    };
+    let weight = loaded.camera.generate_ray_differential(&sample, &mut ray);
+    if weight > 0.0 {
+        weight * radiance(loaded, strategy, ray, rng, loaded.max_depth)
+    } else {
+        Vec3::ZERO
+    }
+}
+
 /// A linear RGB image, row-major.
 #[derive(Clone)]
 pub struct Image {
@@ -303,22 +331,7 @@ pub fn render_pass(
                 }
                 let mut rng = Rng::new((y * w + x) as u64, pass);
                 for _ in 0..spp {
-                    let sample = CameraSample {
-                        p_film: Point2f {
-                            x: x as f32 + rng.f32(),
-                            y: y as f32 + rng.f32(),
-                        },
-                        p_lens: rng.p2(),
-                        time: 0.0,
-                    };
-                    let mut ray = Ray {
-                        t_max: Cell::new(f32::INFINITY),
-                        ..Default::default()
-                    };
-                    let weight = loaded.camera.generate_ray_differential(&sample, &mut ray);
-                    if weight > 0.0 {
-                        *px += weight * radiance(loaded, strategy, ray, &mut rng, loaded.max_depth);
-                    }
+                    *px += sample_pixel(loaded, strategy, (x, y), &mut rng);
                 }
             }
             true
