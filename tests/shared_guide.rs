@@ -193,9 +193,9 @@ fn doubling_refines_after_first_three_and_seven_times_first() {
 }
 
 /// The amortized schedule refines at the first call (nothing took any
-/// time yet), then waits `ratio` times what that refinement took; an
-/// explicit `refine` counts too. Control: with the clock not updated after
-/// a refinement, the second call refines again and this fails.
+/// time yet), then waits `ratio` times what that refinement took. Control:
+/// with the clock not updated after a refinement, the second call refines
+/// again and this fails.
 #[test]
 fn amortized_waits_ratio_times_the_last_refinement() {
     let tree = LightTree::build(&two_rooms(), BuildHeuristic::Sarh).unwrap();
@@ -272,4 +272,59 @@ fn refining_when_due_from_every_path() {
             .sum();
         assert!((total - 1.0).abs() < 1e-6);
     }
+}
+
+/// The SD-tree and the field refine through a `SharedGuide` as they do on
+/// their own: the same records give the same outcome, splits included.
+/// Control: a `Refine` impl that skipped the refinement returns no splits.
+#[test]
+fn the_sd_tree_and_the_field_refine_through_the_shared_guide() {
+    use guiding::{FieldConfig, GuidingField, SdTree, SdTreeConfig};
+    let sd_config = SdTreeConfig {
+        spatial_threshold: 100.0,
+        ..SdTreeConfig::default()
+    };
+    let record = |f: &dyn Fn(&ShadingContext)| {
+        let mut rng = Rand::new(5);
+        for _ in 0..4000 {
+            f(&ShadingContext::at(rng.point(9.5)));
+        }
+    };
+    let dir = Vec3::Y;
+    let mut alone = SdTree::new(scene(), sd_config).unwrap();
+    record(&|ctx| drop(alone.vertex(ctx).unwrap().record_radiance(dir, 1.0, 1.0)));
+    let shared = SharedGuide::new(SdTree::new(scene(), sd_config).unwrap());
+    record(&|ctx| {
+        drop(
+            shared
+                .read()
+                .vertex(ctx)
+                .unwrap()
+                .record_radiance(dir, 1.0, 1.0),
+        )
+    });
+    let expected = alone.refine();
+    assert!(expected.splits > 0);
+    assert_eq!(shared.refine(), expected);
+
+    let tree = LightTree::build(&two_rooms(), BuildHeuristic::Sarh).unwrap();
+    let config = FieldConfig {
+        sd: sd_config,
+        ..FieldConfig::default()
+    };
+    let mut alone = GuidingField::new(&tree, scene(), config).unwrap();
+    let field_record = |f: &GuidingField<&LightTree>, ctx: &ShadingContext| {
+        drop(
+            f.vertex(ctx)
+                .unwrap()
+                .direction
+                .record_radiance(dir, 1.0, 1.0),
+        );
+    };
+    record(&|ctx| field_record(&alone, ctx));
+    let shared = SharedGuide::new(GuidingField::new(&tree, scene(), config).unwrap());
+    record(&|ctx| field_record(&shared.read(), ctx));
+    let expected = alone.refine();
+    assert!(expected.splits > 0);
+    assert_eq!(shared.refine(), expected);
 }
