@@ -292,7 +292,9 @@ fn the_sd_tree_and_the_field_refine_through_the_shared_guide() {
     };
     let dir = Vec3::Y;
     let mut alone = SdTree::new(scene(), sd_config).unwrap();
-    record(&|ctx| drop(alone.vertex(ctx).unwrap().record_radiance(dir, 1.0, 1.0)));
+    record(&|ctx| {
+        let _ = alone.vertex(ctx).unwrap().record_radiance(dir, 1.0, 1.0);
+    });
     let shared = SharedGuide::new(SdTree::new(scene(), sd_config).unwrap());
     record(&|ctx| {
         drop(
