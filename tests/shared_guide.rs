@@ -297,13 +297,11 @@ fn the_sd_tree_and_the_field_refine_through_the_shared_guide() {
     });
     let shared = SharedGuide::new(SdTree::new(scene(), sd_config).unwrap());
     record(&|ctx| {
-        drop(
-            shared
-                .read()
-                .vertex(ctx)
-                .unwrap()
-                .record_radiance(dir, 1.0, 1.0),
-        )
+        let _ = shared
+            .read()
+            .vertex(ctx)
+            .unwrap()
+            .record_radiance(dir, 1.0, 1.0);
     });
     let expected = alone.refine();
     assert!(expected.splits > 0);
@@ -316,12 +314,11 @@ fn the_sd_tree_and_the_field_refine_through_the_shared_guide() {
     };
     let mut alone = GuidingField::new(&tree, scene(), config).unwrap();
     let field_record = |f: &GuidingField<&LightTree>, ctx: &ShadingContext| {
-        drop(
-            f.vertex(ctx)
-                .unwrap()
-                .direction
-                .record_radiance(dir, 1.0, 1.0),
-        );
+        let _ = f
+            .vertex(ctx)
+            .unwrap()
+            .direction
+            .record_radiance(dir, 1.0, 1.0);
     };
     record(&|ctx| field_record(&alone, ctx));
     let shared = SharedGuide::new(GuidingField::new(&tree, scene(), config).unwrap());
