@@ -152,19 +152,24 @@ fn refinements_in_the_middle_of_a_render_keep_the_contracts() {
         }
     });
     assert!(shared.refinements() >= 6);
-    let glt = shared.read();
+    keeps_the_contracts(&shared.read(), &tree);
+}
+
+/// Every cut valid; at 50 points the pmf over the 80 lights sums to 1 and
+/// a sample's pmf is the pmf of its light.
+fn keeps_the_contracts(glt: &Glt<&LightTree>, tree: &LightTree) {
     for cell in glt.spatial().data_slice() {
-        assert!(cell.cut().check(&tree).is_ok());
+        assert!(cell.cut().check(tree).is_ok());
     }
     let mut rng = Rand::new(7);
     for _ in 0..50 {
         let ctx = ShadingContext::at(rng.point(9.0));
         let total: f64 = (0..80)
-            .map(|e| ByPosition(&*glt).pmf_exact(&ctx, LightId::Emitter(e)))
+            .map(|e| ByPosition(glt).pmf_exact(&ctx, LightId::Emitter(e)))
             .sum();
         assert!((total - 1.0).abs() < 1e-6);
-        let x = ByPosition(&*glt).sample(&ctx, rng.f()).unwrap();
-        assert_eq!(x.pmf, ByPosition(&*glt).pmf(&ctx, x.light));
+        let x = ByPosition(glt).sample(&ctx, rng.f()).unwrap();
+        assert_eq!(x.pmf, ByPosition(glt).pmf(&ctx, x.light));
     }
 }
 
@@ -263,15 +268,7 @@ fn refining_when_due_from_every_path() {
         }
     });
     assert!(shared.refinements() >= 2, "{}", shared.refinements());
-    let glt = shared.read();
-    let mut rng = Rand::new(8);
-    for _ in 0..50 {
-        let ctx = ShadingContext::at(rng.point(9.0));
-        let total: f64 = (0..80)
-            .map(|e| ByPosition(&*glt).pmf_exact(&ctx, LightId::Emitter(e)))
-            .sum();
-        assert!((total - 1.0).abs() < 1e-6);
-    }
+    keeps_the_contracts(&shared.read(), &tree);
 }
 
 /// The SD-tree and the field refine through a `SharedGuide` as they do on
