@@ -307,7 +307,9 @@ fn importance(q: &FastQuery, e: &Entry) -> f64 {
         imp *= f64::from(cos_sub_clamped(sin_of(cos_i), cos_i, sin_b, cos_b).max(0.0));
     }
     let imp = phi * imp;
-    if imp >= 0.0 && imp.is_finite() {
+    // Finite and not negative, NaN excluded: two comparisons (`is_finite`
+    // compiles to integer masking, 2 x 12 instructions a level).
+    if (0.0..f64::INFINITY).contains(&imp) {
         imp
     } else {
         0.0

@@ -349,6 +349,13 @@ macro_rules! measure {
             .zip(&x.u)
             .map(|(v, &u)| v.as_ref().and_then(|v| v.sample(u)))
             .collect();
+        if !$args.child {
+            println!(
+                "  {:<8} digest {:016x}",
+                stringify!($m),
+                digest(&vertices, &sampled, x)
+            );
+        }
         let mut out: Vec<(&'static str, f64, usize)> = Vec::new();
         for op in OPS {
             if (op == "record" && !learns(c)) || !args_ops.iter().any(|o| o == op) {
@@ -373,6 +380,48 @@ macro_rules! measure {
         }
         out
     }};
+}
+
+/// A digest of every choice the measured operations make: each sampled
+/// light and the bits of its pmf, the pmf of each light a BSDF ray hit,
+/// and each candidate with its pmf and learned visibility. Two builds that
+/// print the same digest chose the same lights with the same
+/// probabilities, to the last bit (an optimisation that claims to change
+/// no distribution shows it here).
+fn digest<V: LightChoice>(
+    vertices: &[Option<V>],
+    sampled: &[Option<LightSample>],
+    x: &Inputs,
+) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325_u64;
+    let mut eat = |word: u64| {
+        for b in word.to_le_bytes() {
+            h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    let id = |l: LightId| match l {
+        LightId::Emitter(e) => u64::from(e),
+        LightId::Unbounded(i) => u64::from(i) | 1 << 40,
+    };
+    for s in sampled.iter().flatten() {
+        eat(id(s.light));
+        eat(u64::from(s.pmf.to_bits()));
+    }
+    for &(i, light) in &x.hits {
+        if let Some(v) = &vertices[i] {
+            eat(u64::from(v.pmf(light).to_bits()));
+        }
+    }
+    for (v, u) in vertices.iter().zip(x.uc.chunks_exact(CANDIDATES)) {
+        let Some(v) = v else { continue };
+        for &u in u {
+            if let Some((s, visibility)) = v.sample_with_visibility(u) {
+                eat(id(s.light));
+                eat(u64::from(s.pmf.to_bits()) << 32 | u64::from(visibility.to_bits()));
+            }
+        }
+    }
+    h
 }
 
 /// Whether `C` learns (its records are measured).
