@@ -255,8 +255,9 @@ impl ImportanceTable {
     #[inline(always)]
     pub(crate) fn pair_importance(&self, q: &FastQuery, pair: u32) -> (f64, f64) {
         match self.pairs.get(pair as usize) {
-            Some(Pair([l, r])) => (importance(q, l), importance(q, r)),
-            None => (0.0, 0.0),
+            // The point's finiteness is tested once for both.
+            Some(Pair([l, r])) if q.finite => (importance(q, l), importance(q, r)),
+            _ => (0.0, 0.0),
         }
     }
 }
@@ -264,10 +265,12 @@ impl ImportanceTable {
 /// The importance of `e` at `q`: the bound of [`crate::light_sampler::importance()`] (power
 /// x conservative emission cosine / squared distance clamped to the
 /// bounding sphere, x the conservative `|cos|` to the normal), evaluated in
-/// `f32` up to the final quotient. Finite, never negative.
+/// `f32` up to the final quotient, at a finite point `q`. Finite, never
+/// negative.
 #[inline(always)]
 fn importance(q: &FastQuery, e: &Entry) -> f64 {
-    if !(e.power > 0.0 && q.finite) {
+    // An entry's power is finite: 0 marks one that cannot contribute.
+    if e.power <= 0.0 {
         return 0.0;
     }
     let to_p = q.p - Vec3::from_array(e.center);
