@@ -24,6 +24,9 @@
 //! cargo run --release --bin choice_cost -- --scene city,ring,torus --callgrind
 //! ```
 //!
+//! How the cost grows with the number of emitters: the city on grids of 2
+//! to 61 blocks (1k to 1M emitters), `--scene city:2,city:6,city:20,city:61`.
+//!
 //! Each operation is its own `#[inline(never)]` function per sampler
 //! (`choice_cost::glt::sample`, ...), so callgrind's inclusive count of a
 //! function divided by the operations it ran is the cost of one.
@@ -48,7 +51,9 @@ const CANDIDATES: usize = 8;
 #[derive(Parser, Debug, Clone)]
 #[command(about = "Instructions and time per light-choice operation")]
 struct Args {
-    /// Scenes, comma-separated.
+    /// Scenes, comma-separated; `city:<blocks>` is the city on a
+    /// `blocks` x `blocks` grid (`city` is `city:20`, about 108k emitters;
+    /// `city:2,city:6,city:20,city:61` spans 1k to 1M).
     #[arg(long, default_value = "city,ring,torus", value_delimiter = ',')]
     scene: Vec<String>,
     /// Shading points.
@@ -525,6 +530,10 @@ fn measure_scene(args: &Args, name: &str) -> Result<Rows, String> {
         &*Box::leak(Box::new(Field(field_guide))),
     );
     let x = Inputs::new(scene, args.points, 7);
+    if !args.child {
+        use guiding::LightHierarchy;
+        println!("{name}: {} emitters", scene.light_tree.emitter_count());
+    }
     if args.stats {
         walk_stats(name, scene, glt_guide, &x);
     }

@@ -20,6 +20,13 @@ pub fn build_street(size: Size) -> Scene {
     build_with(size, View::Street)
 }
 
+/// The city of [`build`] on a `blocks` x `blocks` grid (20 is `city`'s,
+/// about 108k emitters; the emitters grow as `blocks^2`): for measuring how
+/// a light sampler's cost grows with the number of lights.
+pub fn build_blocks(blocks: usize) -> Scene {
+    build_grid(blocks.max(1), View::Overview)
+}
+
 /// Where the camera is.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum View {
@@ -34,6 +41,11 @@ fn build_with(size: Size, view: View) -> Scene {
         Size::Full => 20usize,
         Size::Small => 6,
     };
+    build_grid(blocks, view)
+}
+
+/// The city on a `blocks` x `blocks` grid, seen from `view`.
+fn build_grid(blocks: usize, view: View) -> Scene {
     let mut b = SceneBuilder::new();
     let ground = b.material(Material::Diffuse {
         albedo: Vec3::splat(0.25),

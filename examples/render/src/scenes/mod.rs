@@ -41,8 +41,14 @@ pub const DEFAULT: &str = "city-street";
 /// The image size a run renders unless told otherwise.
 pub const DEFAULT_SIZE: (u32, u32) = (256, 192);
 
-/// Builds the scene called `name`; `None` for an unknown name.
+/// Builds the scene called `name`; `None` for an unknown name. Besides
+/// [`NAMES`], `city:<blocks>` is the city on a `blocks` x `blocks` grid
+/// (`city` is `city:20`), whatever `size`: the light count grows as
+/// `blocks^2` (`choice_cost` measures cost against it).
 pub fn build(name: &str, size: Size) -> Option<Scene> {
+    if let Some(blocks) = name.strip_prefix("city:") {
+        return blocks.parse().ok().map(city::build_blocks);
+    }
     Some(match name {
         "ring" => ring::build(size),
         "city" => city::build(size),
