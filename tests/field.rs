@@ -969,10 +969,11 @@ fn memory_report_adds_up_and_compares_cuts_with_quadtrees() {
     // modulation's 7 anchor sums, per cell.
     assert_eq!(m.cuts.sum_bytes, 8 * (2 * nodes + 7 * m.sd.cells));
     // Split table 4 B per node; walk table one 16-B pair per inner node +
-    // root; the default importance rules' table one 64-B pair beside it.
+    // root and an 8-B path code per emitter; the default importance rules'
+    // table one 64-B pair beside it.
     assert_eq!(
         m.shared_bytes,
-        4 * tree.node_count() + (8 + 32) * (tree.node_count() + 1)
+        4 * tree.node_count() + (8 + 32) * (tree.node_count() + 1) + 8 * tree.emitter_count()
     );
     assert_eq!(m.cut_bytes(), m.cuts.node_bytes + m.cuts.sum_bytes);
     assert_eq!(m.quadtree_bytes(), m.sd.quadtree_bytes);

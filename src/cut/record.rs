@@ -5,6 +5,7 @@ use super::cut_rules::CutRules;
 use super::guiding_cut::GuidingCut;
 use crate::light_sampler::LightId;
 use crate::light_tree::LightHierarchy;
+use crate::math::Side;
 use crate::record::RecordOutcome;
 use glam::Vec3;
 
@@ -19,6 +20,17 @@ impl GuidingCut {
     ) -> Option<usize> {
         let path = tree.path(emitter)?;
         let power = tree.power(path.leaf());
+        self.slot_along(power, path.steps().iter().map(|&(_, side)| side))
+    }
+
+    /// [`GuidingCut::slot_of`] an emitter of power `power` whose path from
+    /// the root takes `sides`.
+    #[inline]
+    pub(crate) fn slot_along(
+        &self,
+        power: f32,
+        sides: impl Iterator<Item = Side>,
+    ) -> Option<usize> {
         if power.is_nan() || power <= 0.0 {
             return None;
         }
@@ -26,7 +38,7 @@ impl GuidingCut {
             return Some(0);
         }
         let mut i = 0u32;
-        for &(_, side) in path.steps() {
+        for side in sides {
             let node = self.nodes.get(i as usize)?;
             match node.child(side) {
                 Some(j) => i = j,
@@ -46,7 +58,17 @@ impl<H: LightHierarchy> CutRules<H> {
     #[inline]
     pub(super) fn sum_of(&self, cut: &GuidingCut, light: LightId) -> Option<usize> {
         match light {
-            LightId::Emitter(e) => cut.slot_of(self.light_tree(), e),
+            // The path code (flat trees, at most 63 levels) spares
+            // rebuilding the path from parent links.
+            LightId::Emitter(e) => match (self.instanced(), self.tables().walk().code(e)) {
+                (None, Some(code)) => {
+                    let tree = self.light_tree();
+                    let power = tree.leaf(e).map_or(0.0, |n| tree.power(n));
+                    let sides = (0..code.depth()).map(|l| code.side(l));
+                    cut.slot_along(power, sides)
+                }
+                _ => cut.slot_of(self.light_tree(), e),
+            },
             LightId::Unbounded(i) => {
                 (i < self.config().unbounded.count).then(|| cut.first_unbounded_sum() + i as usize)
             }

@@ -43,7 +43,7 @@ use super::importance_table::FastQuery;
 use super::instanced_tables::{InstancedTables, mesh_of};
 use super::split_table::decode_split;
 use super::tables::Segment;
-use super::walk::WalkNode;
+use super::walk::{PathCode, WalkNode};
 use crate::light_sampler::ShadingContext;
 use crate::light_sampler::{LightId, LightSample, choose_unbounded};
 use crate::light_tree::{InstancedLightTree, LightHierarchy};
@@ -666,12 +666,14 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
             cut: 1.0,
             prior: 1.0,
         };
-        let found = match self.guide.instanced() {
-            None => self
+        let found = match (self.guide.instanced(), self.top.walk.code(emitter)) {
+            (None, Some(code)) => self.pmf_coded(&self.top, &mut at, &mut p, code),
+            // Deeper than a code holds.
+            (None, None) => self
                 .tree
                 .path(emitter)
                 .is_some_and(|path| self.pmf_along(&self.top, &mut at, &mut p, path.steps())),
-            Some((tables, tree)) => self.pmf_instanced(tables, tree, emitter, &mut at, &mut p),
+            (Some((tables, tree)), _) => self.pmf_instanced(tables, tree, emitter, &mut at, &mut p),
         };
         match found {
             true => self.mixture.emitter_pmf(p),
@@ -710,6 +712,31 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
         };
         at.node = root;
         self.pmf_along(&seg, at, p, inner.steps())
+    }
+
+    /// [`Rule::pmf_along`] the path `code` gives, down the walk table from
+    /// `at` (each node's split read from its walk entry, the same `f32` the
+    /// split table holds, so the products are the ones `sample` forms).
+    #[inline(always)]
+    fn pmf_coded(&self, seg: &Segment, at: &mut Cursor, p: &mut Products, code: PathCode) -> bool {
+        for level in 0..code.depth() {
+            let Some(k) = at.node.children() else {
+                return false;
+            };
+            let side = code.side(level);
+            let split = at.node.split;
+            let step = self
+                .restriction
+                .restrict(self.step(seg, *at, split), split, || Some(seg.pair_sets(k)));
+            self.apply(p, &step, side);
+            if p.cut == 0.0 && (!self.prior || p.prior == 0.0) {
+                return false;
+            }
+            let i = side.index();
+            at.cut = step.next[i].and_then(|c| self.nodes.get(c as usize).copied());
+            at.node = seg.walk.pair(k).0[i];
+        }
+        at.node.children().is_none()
     }
 
     /// Multiplies into `p` the steps along `path` in segment `seg`, from
