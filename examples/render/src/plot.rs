@@ -323,3 +323,46 @@ pub fn sigma_study(stem: &Path, scene: &str, records: &[Record]) -> Result<[Path
         .collect();
     write_svg_and_png(stem, (960, 420), &SigmaStudy { scene, studied })
 }
+
+/// A log-log chart of `lines` (each a label and its points), captioned
+/// `caption`, with the axes `x` and `y` described as given; written to
+/// `<stem>.svg` and `<stem>.png`.
+pub fn log_log(
+    stem: &Path,
+    caption: &str,
+    (x_desc, y_desc): (&str, &str),
+    lines: &[(String, Vec<(f64, f64)>)],
+) -> Result<[PathBuf; 2], String> {
+    struct Lines<'a> {
+        caption: &'a str,
+        desc: (&'a str, &'a str),
+        lines: &'a [(String, Vec<(f64, f64)>)],
+    }
+    impl Chart for Lines<'_> {
+        fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String> {
+            let points = || self.lines.iter().flat_map(|(_, p)| p.iter().copied());
+            let range = |f: fn((f64, f64)) -> f64| {
+                let v = points().map(f).filter(|v| *v > 0.0);
+                let (lo, hi) = v.fold((f64::MAX, f64::MIN), |(lo, hi), v| (lo.min(v), hi.max(v)));
+                (lo * 0.8, hi * 1.25)
+            };
+            let (x, y) = (range(|p| p.0), range(|p| p.1));
+            if !(x.0 < x.1 && y.0 < y.1) {
+                return Err(format!("{}: nothing to plot", self.caption));
+            }
+            log_log_chart(
+                area,
+                self.caption,
+                (self.desc.0, x),
+                (self.desc.1, y),
+                self.lines,
+            )
+        }
+    }
+    let chart = Lines {
+        caption,
+        desc: (x_desc, y_desc),
+        lines,
+    };
+    write_svg_and_png(stem, (760, 480), &chart)
+}

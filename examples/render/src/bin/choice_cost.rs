@@ -96,6 +96,12 @@ struct Args {
     /// below the cut.
     #[arg(long)]
     stats: bool,
+    /// Also plot each sampler's cost per `sample` and per `pmf-hit`
+    /// against the scenes' emitter counts (instructions with --callgrind,
+    /// else time), log-log, to `<PLOT>-sample.svg` and `<PLOT>-pmf-hit.svg`
+    /// (and `.png`).
+    #[arg(long)]
+    plot: Option<PathBuf>,
     /// (Internal) load the guides from --out instead of training: the
     /// callgrind child.
     #[arg(long, hide = true)]
@@ -519,7 +525,7 @@ fn walk_stats(name: &str, scene: &Scene, glt: &Glt<&LightTree>, x: &Inputs) {
 /// One row per (sampler, op): seconds per op and ops per repetition.
 type Rows = Vec<(String, &'static str, f64, usize)>;
 
-fn measure_scene(args: &Args, name: &str) -> Result<Rows, String> {
+fn measure_scene(args: &Args, name: &str) -> Result<(Rows, usize), String> {
     let scene = scenes::build(name, scenes::Size::Full).ok_or(format!("no scene {name}"))?;
     // The named copies take `'static` borrows: leak this scene's (the
     // process measures a few scenes and ends).
@@ -550,7 +556,8 @@ fn measure_scene(args: &Args, name: &str) -> Result<Rows, String> {
         };
         rows.extend(r.into_iter().map(|(op, t, n)| (s.clone(), op, t, n)));
     }
-    Ok(rows)
+    use guiding::LightHierarchy;
+    Ok((rows, scene.light_tree.emitter_count()))
 }
 
 /// The instructions per operation of each (sampler, op), from a callgrind
@@ -601,8 +608,10 @@ fn callgrind(args: &Args, name: &str, rows: &Rows) -> Result<Vec<f64>, String> {
 
 fn main() -> ExitCode {
     let args = Args::parse();
+    // (sampler, op) -> (emitters, cost) over the scenes, for --plot.
+    let mut growth: Vec<(String, &'static str, Vec<(f64, f64)>)> = Vec::new();
     for name in &args.scene {
-        let rows = match measure_scene(&args, name) {
+        let (rows, emitters) = match measure_scene(&args, name) {
             Ok(r) => r,
             Err(e) => {
                 eprintln!("choice_cost: {e}");
@@ -629,6 +638,37 @@ fn main() -> ExitCode {
                 .as_ref()
                 .map_or(String::new(), |i| format!(" {:>9.0}", i[k]));
             println!("  {s:<8} {op:<12} {:>9.1}{i} ({n})", t * 1e9);
+            let cost = instr.as_ref().map_or(t * 1e9, |i| i[k]);
+            match growth.iter_mut().find(|(g, o, _)| g == s && o == op) {
+                Some((_, _, points)) => points.push((emitters as f64, cost)),
+                None => growth.push((s.clone(), op, vec![(emitters as f64, cost)])),
+            }
+        }
+    }
+    if let Some(stem) = &args.plot {
+        let unit = if args.callgrind { "instructions" } else { "ns" };
+        for op in ["sample", "pmf-hit"] {
+            let lines: Vec<(String, Vec<(f64, f64)>)> = growth
+                .iter()
+                .filter(|(_, o, p)| *o == op && p.len() > 1)
+                .map(|(s, _, p)| (s.clone(), p.clone()))
+                .collect();
+            if lines.is_empty() {
+                continue;
+            }
+            let stem = stem.with_file_name(format!(
+                "{}-{op}",
+                stem.file_name()
+                    .map_or("growth".into(), |f| f.to_string_lossy())
+            ));
+            let caption = format!("{unit} per {op} against the number of emitters");
+            match guiding_render::plot::log_log(&stem, &caption, ("emitters", unit), &lines) {
+                Ok([svg, _]) => println!("wrote {}", svg.display()),
+                Err(e) => {
+                    eprintln!("choice_cost: {e}");
+                    return ExitCode::FAILURE;
+                }
+            }
         }
     }
     ExitCode::SUCCESS
