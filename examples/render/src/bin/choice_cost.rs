@@ -606,10 +606,12 @@ fn callgrind(args: &Args, name: &str, rows: &Rows) -> Result<Vec<f64>, String> {
         .collect())
 }
 
+/// A (sampler, op) pair's (emitters, cost) over the scenes, for --plot.
+type Growth = (String, &'static str, Vec<(f64, f64)>);
+
 fn main() -> ExitCode {
     let args = Args::parse();
-    // (sampler, op) -> (emitters, cost) over the scenes, for --plot.
-    let mut growth: Vec<(String, &'static str, Vec<(f64, f64)>)> = Vec::new();
+    let mut growth: Vec<Growth> = Vec::new();
     for name in &args.scene {
         let (rows, emitters) = match measure_scene(&args, name) {
             Ok(r) => r,
