@@ -16,9 +16,10 @@ use alloc::vec::Vec;
 
 /// The tables of one light tree: each inner node's power split (4 bytes
 /// per node, see `encode_split`), the tree re-laid out for sampling walks
-/// (8 bytes per node and a path code of 8 bytes per emitter, `walk.rs`), the decoded importance table when a rule
-/// uses importance (32 bytes per node) and, when the tree has light sets,
-/// both children's sets per walk-table pair.
+/// (8 bytes per node, and a path code of 8 bytes per emitter: `walk.rs`),
+/// the decoded importance table when a rule uses importance (32 bytes per
+/// node) and, when the tree has light sets, both children's sets per
+/// walk-table pair.
 #[derive(Clone, Debug)]
 pub(crate) struct TreeTables {
     split: Vec<f32>,
