@@ -346,11 +346,21 @@ mod tests {
                 .collect();
             check(&LightTree::build(&lights, BuildHeuristic::default()).unwrap());
         }
-        // A chain deeper than 64 levels (powers halving along one line).
+        // A chain deeper than 64 levels: boxes and powers halving towards
+        // the origin (powers halving alone build only 7 levels), so codes
+        // end at 63 levels and deeper leaves take the parent links.
         let chain: Vec<Emitter> = (0..100)
-            .map(|i| Emitter::point(Vec3::new(i as f32, 0.0, 0.0), 0.5f32.powi(i)))
+            .map(|k| {
+                let s = 2f32.powi(-k);
+                let b = crate::math::Aabb::new(
+                    Vec3::new(s, 0.0, 0.0),
+                    Vec3::new(1.1 * s, 0.1 * s, 0.1 * s),
+                );
+                Emitter::area(b, Vec3::Z, 0.01 * s * s, s)
+            })
             .collect();
-        let tree = LightTree::build(&chain, BuildHeuristic::default()).unwrap();
+        let tree = LightTree::build(&chain, BuildHeuristic::Sarh).unwrap();
+        assert!(tree.depth() > 64, "depth {}", tree.depth());
         check(&tree);
     }
 }
