@@ -724,19 +724,39 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
                 return false;
             };
             let side = code.side(level);
-            let split = at.node.split;
-            let step = self
-                .restriction
-                .restrict(self.step(seg, *at, split), split, || Some(seg.pair_sets(k)));
-            self.apply(p, &step, side);
-            if p.cut == 0.0 && (!self.prior || p.prior == 0.0) {
+            if !self.pmf_step(seg, at, p, at.node.split, side) {
                 return false;
             }
-            let i = side.index();
-            at.cut = step.next[i].and_then(|c| self.nodes.get(c as usize).copied());
-            at.node = seg.walk.pair(k).0[i];
+            at.node = seg.walk.pair(k).0[side.index()];
         }
         at.node.children().is_none()
+    }
+
+    /// One level of a pmf walk at `at`, whose node's split-table entry is
+    /// `split`: multiplies the probabilities of `side` into `p` and moves
+    /// `at`'s cut node to that side (the caller moves its walk-table
+    /// entry); false once both products are 0.
+    #[inline(always)]
+    fn pmf_step(
+        &self,
+        seg: &Segment,
+        at: &mut Cursor,
+        p: &mut Products,
+        split: f32,
+        side: Side,
+    ) -> bool {
+        let pair = at.node.children();
+        let step = self
+            .restriction
+            .restrict(self.step(seg, *at, split), split, || {
+                pair.map(|k| seg.pair_sets(k))
+            });
+        self.apply(p, &step, side);
+        if p.cut == 0.0 && (!self.prior || p.prior == 0.0) {
+            return false;
+        }
+        at.cut = step.next[side.index()].and_then(|i| self.nodes.get(i as usize).copied());
+        true
     }
 
     /// Multiplies into `p` the steps along `path` in segment `seg`, from
@@ -758,17 +778,9 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
         // sets are laid out like it), only when they are read.
         let follow = seg.importance.is_some() || R::LINKED;
         for &(node, side) in path {
-            let split = seg.raw_split(node);
-            let step = self
-                .restriction
-                .restrict(self.step(seg, *at, split), split, || {
-                    at.node.children().map(|k| seg.pair_sets(k))
-                });
-            self.apply(p, &step, side);
-            if p.cut == 0.0 && (!self.prior || p.prior == 0.0) {
+            if !self.pmf_step(seg, at, p, seg.raw_split(node), side) {
                 return false;
             }
-            at.cut = step.next[side.index()].and_then(|i| self.nodes.get(i as usize).copied());
             if follow {
                 match at.node.children() {
                     Some(k) => at.node = seg.walk.pair(k).0[side.index()],
