@@ -178,6 +178,10 @@ impl<T> Evaluated<T> {
     }
 }
 
+/// How many candidates [`resample`] draws in one
+/// [`LightChoice::sample_candidates`] call.
+const BATCH: usize = 16;
+
 /// The light the BSDF sample found, as a candidate ([`resample`]): the
 /// light and the renderer's evaluation of the point it hit (its
 /// `pdf_bsdf` positive).
@@ -187,7 +191,8 @@ pub type BsdfCandidate<T> = (LightId, Evaluated<T>);
 /// candidates of the point's light choice `lights` (a guide's vertex, or
 /// [`LightSampler::at`](crate::LightSampler::at) the point), and the BSDF
 /// sample's light when it takes part: candidate `j` is drawn with
-/// `lights.sample(candidates[j])`,
+/// `lights.sample_with_visibility(candidates[j])` (all of them through
+/// [`LightChoice::sample_candidates`], a batch at a time),
 /// `evaluate(light, j)` says what it contributes without visibility (the
 /// renderer samples a point on the light; `None` counts as no
 /// contribution), and `u` keeps one in proportion to its weight (see the
@@ -212,14 +217,21 @@ where
 {
     let m = candidates.len() as f64;
     let mut reservoir = Reservoir::new(u);
-    for (j, &uj) in candidates.iter().enumerate() {
-        let Some((x, learned)) = lights.sample_with_visibility(uj) else {
-            continue;
-        };
-        let Some(e) = evaluate(x.light, j) else {
-            continue;
-        };
-        reservoir.offer(x.light, x.pmf, m, learned, e, false);
+    // Drawn a batch at a time, so a guide's walks share their common steps
+    // (`LightChoice::sample_candidates`).
+    let mut drawn = [None; BATCH];
+    for (b, batch) in candidates.chunks(BATCH).enumerate() {
+        let drawn = &mut drawn[..batch.len()];
+        lights.sample_candidates(batch, drawn);
+        for (i, d) in drawn.iter().enumerate() {
+            let Some((x, learned)) = *d else {
+                continue;
+            };
+            let Some(e) = evaluate(x.light, b * BATCH + i) else {
+                continue;
+            };
+            reservoir.offer(x.light, x.pmf, m, learned, e, false);
+        }
     }
     if let Some((light, e)) = bsdf.filter(|(_, e)| e.pdf_bsdf > 0.0) {
         reservoir.offer(light, lights.pmf(light), m, 1.0, e, true);

@@ -289,6 +289,9 @@ fn the_glt_learns_inside_instances() {
             let on_surface = ShadingContext::on_surface(p, r.dir());
             let v = glt.vertex(&on_surface).unwrap();
             check("glt", &v, &flat, &on_surface, &mut r);
+            // Walks into the instances' tables share only the top tree's
+            // steps; together or alone, the same candidates.
+            assert!(common::candidates_match(&v, &mut r) > 0);
         }
     }
 }

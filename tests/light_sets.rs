@@ -155,6 +155,14 @@ fn the_restricted_glt_draws_what_its_pmf_says() {
         .map(|i| all.pmf_exact(LightId::Emitter(i as u32)))
         .sum();
     assert!(outside > 0.05, "the control: {outside}");
+    // Candidates drawn together follow the same restricted walk.
+    let mut r = Rand::new(115);
+    let mut answered = 0;
+    for sets in [0b01, 0b10, 0b100, u64::MAX] {
+        let ctx = ShadingContext::on_surface(r.point(50.0), r.dir()).lit_by(sets);
+        answered += common::candidates_match(&glt.vertex(&ctx).unwrap(), &mut r);
+    }
+    assert!(answered > 300, "{answered} candidates answered");
 }
 
 /// Without restriction a tree with light sets samples bit for bit as the

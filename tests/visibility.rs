@@ -274,6 +274,67 @@ fn sampling_with_visibility_equals_sampling_then_visibility() {
     }
 }
 
+/// Candidates drawn together (`sample_candidates`, each step the walks
+/// share computed once) are exactly the candidates drawn alone, learned
+/// visibility included, at trained cuts with and without unbounded lights
+/// and on a 100-level chain (deeper than the walks' memo of 16 levels).
+/// Control: a memo that keys its steps by level alone, not by node, gives
+/// other lights on most batches (checked by hand when written).
+#[test]
+fn candidates_drawn_together_are_the_candidates_drawn_alone() {
+    let lights = two_rooms();
+    let mut rng = Rand::new(78);
+    for unbounded in [
+        guiding::UnboundedLights::NONE,
+        guiding::UnboundedLights::new(2, 0.2).unwrap(),
+    ] {
+        let mut cfg = config(true);
+        cfg.cut.unbounded = unbounded;
+        let mut glt = Glt::new(tree(), scene(), cfg).unwrap();
+        for _ in 0..3 {
+            for _ in 0..8000 {
+                let p = rng.point(9.5);
+                let Some(x) = ByPosition(&glt).sample(&ShadingContext::at(p), rng.f()) else {
+                    continue;
+                };
+                let (seen, open) = match x.light {
+                    LightId::Emitter(e) => (value(&lights, e, p), unshadowed(&lights, e, p)),
+                    LightId::Unbounded(i) => (if i == 0 && rng.f() < 0.5 { 0.0 } else { 1.0 }, 1.0),
+                };
+                glt.record_light_at(p, x.light, seen / x.pmf);
+                glt.record_visibility_at(p, x.light, seen / x.pmf, open / x.pmf);
+            }
+            glt.refine();
+        }
+        let mut answered = 0;
+        for _ in 0..200 {
+            let ctx = ShadingContext::on_surface(rng.point(9.5), rng.dir());
+            answered += common::candidates_match(&glt.vertex(&ctx).unwrap(), &mut rng);
+        }
+        assert!(answered > 20_000, "{answered} candidates answered");
+        // A point that is not finite answers nothing, together or alone.
+        let here = glt.vertex(&ShadingContext::at(Vec3::ZERO)).unwrap();
+        let nowhere = ShadingContext::at(Vec3::new(f32::NAN, 0.0, 0.0));
+        let lost = glt.cut_rules().vertex(here.cut(), &nowhere);
+        assert_eq!(common::candidates_match(&lost, &mut rng), 0);
+    }
+    let chain = common::Chain::deep();
+    let rules = guiding::cut::CutRules::new(&chain, CutConfig::default()).unwrap();
+    let mut cut = rules.new_cut();
+    for _ in 0..16 {
+        for k in 0..chain.n() {
+            rules.record(&cut, LightId::Emitter(k), common::Chain::deep_target(k));
+        }
+        rules.refine(&mut cut);
+    }
+    let mut answered = 0;
+    for _ in 0..50 {
+        let ctx = ShadingContext::at(rng.point(5.0));
+        answered += common::candidates_match(&rules.vertex(&cut, &ctx), &mut rng);
+    }
+    assert!(answered > 5_000, "{answered} chain candidates answered");
+}
+
 /// The learned visibility is exactly the module's estimate: the shadowed
 /// over the unshadowed sum, shrunk towards the slot's previous value by
 /// four of the cell's average records, `v = (S + k v0) / (U + k)`, `k = 4

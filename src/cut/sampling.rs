@@ -48,6 +48,7 @@ use crate::light_sampler::ShadingContext;
 use crate::light_sampler::{LightId, LightSample, choose_unbounded};
 use crate::light_tree::{InstancedLightTree, LightHierarchy};
 use crate::math::{Descent, Side, pmf_to_f32};
+use smallvec::SmallVec;
 
 /// The probabilities of the top-level choices in one cell.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -248,6 +249,84 @@ struct Step {
 struct Products {
     cut: f64,
     prior: f64,
+}
+
+/// The deepest level a [`StepMemo`] keeps (deeper levels are computed
+/// every time).
+const MEMO_LEVELS: usize = 16;
+
+/// Where a walk's steps come from: computed at every node ([`NoMemo`],
+/// one sample) or remembered across the walks of one point
+/// ([`StepMemo`], resampling candidates).
+trait Memo {
+    /// Whether anything is remembered (else the walk never asks).
+    const ACTIVE: bool;
+
+    /// The step remembered at level `level` of the top segment for the
+    /// node whose children are walk-table pair `key`.
+    fn get(&self, level: usize, key: u32) -> Option<Step>;
+
+    /// Remembers `step`, computed at that node.
+    fn put(&mut self, level: usize, key: u32, step: Step);
+}
+
+/// Every step computed where it is needed.
+struct NoMemo;
+
+impl Memo for NoMemo {
+    const ACTIVE: bool = false;
+
+    #[inline(always)]
+    fn get(&self, _: usize, _: u32) -> Option<Step> {
+        None
+    }
+
+    #[inline(always)]
+    fn put(&mut self, _: usize, _: u32, _: Step) {}
+}
+
+/// The last step computed at each level of the top segment, by the node it
+/// was computed at. The candidates of one point pass through the same
+/// nodes near the root (and, where the learned choice is sharp, further
+/// down), and a node's step depends only on the node and the point, so a
+/// walk that reaches the node a level's entry holds takes it instead of
+/// evaluating the children's importance again: the same bits for less
+/// work. The key names the node (its children's walk-table pair is unique
+/// in the segment), so an entry is never wrong, only replaced. A walk
+/// reaches level `l` only through levels `0..l`, so the levels fill in
+/// order (nothing is initialised ahead).
+struct StepMemo {
+    levels: SmallVec<[(u32, Step); MEMO_LEVELS]>,
+}
+
+impl StepMemo {
+    fn new() -> Self {
+        Self {
+            levels: SmallVec::new(),
+        }
+    }
+}
+
+impl Memo for StepMemo {
+    const ACTIVE: bool = true;
+
+    #[inline(always)]
+    fn get(&self, level: usize, key: u32) -> Option<Step> {
+        self.levels
+            .get(level)
+            .and_then(|&(k, step)| (k == key).then_some(step))
+    }
+
+    #[inline(always)]
+    fn put(&mut self, level: usize, key: u32, step: Step) {
+        let filled = self.levels.len();
+        if level < filled {
+            self.levels[level] = (key, step);
+        } else if level == filled && level < MEMO_LEVELS {
+            // Never past the inline capacity: no allocation.
+            self.levels.push((key, step));
+        }
+    }
 }
 
 /// `pair` with each side times its factor in `seen`, renormalised; `None`
@@ -520,10 +599,13 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
     /// cut, or its unbounded light's: [`CutRules::sum_of`] of the light,
     /// found without a second walk) when `SUM` (else 0: the walk that does
     /// not need it does not track it).
-    pub(crate) fn sample<const SUM: bool>(
+    /// Steps come from `memo` (the walks of one point's candidates share
+    /// it).
+    fn sample<const SUM: bool>(
         &self,
         mut d: Descent,
         sum: &mut usize,
+        memo: &mut impl Memo,
     ) -> Option<(LightId, f64)> {
         let m = self.mixture;
         if m.unbounded > 0.0 {
@@ -565,7 +647,7 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
         if SUM {
             *sum = 0;
         }
-        self.descend::<SUM>(&self.top, &mut w, &mut d, use_cut, sum)?;
+        self.descend::<SUM, _>(&self.top, &mut w, &mut d, use_cut, sum, memo)?;
         let leaf = w.at.node.emitter()?;
         let emitter = match self.guide.instanced() {
             None => leaf,
@@ -578,32 +660,49 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
 
     /// Walks `w` down segment `seg` to a leaf with the descent `d`, under
     /// the cut's probabilities when `use_cut` (else the prior's), writing
-    /// the slot the walk leaves the cut by to `sum` when `SUM`. `None`
-    /// where neither side can be chosen.
+    /// the slot the walk leaves the cut by to `sum` when `SUM`, its steps
+    /// from `memo`. `None` where neither side can be chosen.
     #[inline(always)]
-    fn descend<const SUM: bool>(
+    fn descend<const SUM: bool, M: Memo>(
         &self,
         seg: &Segment,
         w: &mut Walk,
         d: &mut Descent,
         use_cut: bool,
         sum: &mut usize,
+        memo: &mut M,
     ) -> Option<()> {
         let walk = seg.walk;
         // A copy the loop keeps in registers, written back at the end.
         let (mut at, mut p, mut in_cut) = (w.at, w.p, w.in_cut);
         let mut children = at.node.children().map(|k| walk.pair(k));
+        let mut level = 0;
         while let Some(pair) = children {
             // Load the next level for both sides before choosing: these
             // loads do not depend on `u`, so they overlap with this level's
             // choice instead of waiting for it (the walk is latency-bound).
             let grand = walk.grandchildren(pair);
             let split = at.node.split;
-            let step = self
-                .restriction
-                .restrict(self.step(seg, at, split), split, || {
-                    at.node.children().map(|k| seg.pair_sets(k))
-                });
+            let compute = || {
+                self.restriction
+                    .restrict(self.step(seg, at, split), split, || {
+                        at.node.children().map(|k| seg.pair_sets(k))
+                    })
+            };
+            let step = match M::ACTIVE {
+                // One sample: the loop as if there were no memo.
+                false => compute(),
+                true => {
+                    let key = at.node.children().unwrap_or(u32::MAX);
+                    let step = memo.get(level, key).unwrap_or_else(|| {
+                        let step = compute();
+                        memo.put(level, key, step);
+                        step
+                    });
+                    level += 1;
+                    step
+                }
+            };
             let cuts = self.cut_children(&step);
             let (pl, pr) = if use_cut { step.cut } else { step.prior }?;
             let side = d.choose_with(pl, pr);
@@ -640,7 +739,8 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
     ) -> Option<u32> {
         let seg = tables.segment(i, &self.top.fast)?;
         w.at.node = seg.walk.root()?;
-        self.descend::<SUM>(&seg, w, &mut d, use_cut, sum)?;
+        // Keys name nodes of the top segment only.
+        self.descend::<SUM, _>(&seg, w, &mut d, use_cut, sum, &mut NoMemo)?;
         tables.emitter_id(i, w.at.node.emitter()?)
     }
 
@@ -792,6 +892,9 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
     }
 }
 
+/// How many candidates [`CutRules::sample_candidates`] sorts at a time.
+const ORDERED: usize = 64;
+
 /// A sample converted for the [`crate::LightSampler`] interface.
 #[inline]
 pub(crate) fn to_light_sample(s: Option<(LightId, f64)>) -> Option<LightSample> {
@@ -835,6 +938,59 @@ impl<H: LightHierarchy> CutRules<H> {
         Some((s, self.visibility_at(cut, Some(sum))))
     }
 
+    /// Resampling candidates at `ctx` with `cut`: `out[j]` becomes
+    /// [`CutRules::sample_with_visibility`]`(u[j])` for every `j` (up to
+    /// the shorter slice), bit for bit, but each step the walks share is
+    /// computed once ([`StepMemo`]), and the walks go in increasing order
+    /// of their numbers, so consecutive walks share the longest prefixes
+    /// (a descent keeps the numbers' order). The mixture and the prepared
+    /// point are computed once for all of them.
+    pub fn sample_candidates(
+        &self,
+        cut: &GuidingCut,
+        ctx: &ShadingContext,
+        u: &[f32],
+        out: &mut [Option<(LightSample, f32)>],
+    ) {
+        let n = u.len().min(out.len());
+        let (u, out) = (&u[..n], &mut out[..n]);
+        if !ctx.is_finite() {
+            out.fill(None);
+            return;
+        }
+        match self.receives(ctx) {
+            None => self.candidates_by(&Rule::new(self, cut, ctx, Unrestricted), cut, u, out),
+            Some(r) => self.candidates_by(&Rule::new(self, cut, ctx, r), cut, u, out),
+        }
+    }
+
+    /// [`CutRules::sample_candidates`] by `rule`, in batches of
+    /// [`ORDERED`] numbers sorted once each.
+    fn candidates_by<R: Restriction>(
+        &self,
+        rule: &Rule<'_, H, R>,
+        cut: &GuidingCut,
+        u: &[f32],
+        out: &mut [Option<(LightSample, f32)>],
+    ) {
+        let mut memo = StepMemo::new();
+        for (u, out) in u.chunks(ORDERED).zip(out.chunks_mut(ORDERED)) {
+            let mut order = [0u8; ORDERED];
+            let order = &mut order[..u.len()];
+            for (i, o) in order.iter_mut().enumerate() {
+                *o = i as u8;
+            }
+            // Only the speed depends on the order (a NaN sorts anywhere).
+            order.sort_unstable_by(|&a, &b| u[a as usize].total_cmp(&u[b as usize]));
+            for &j in order.iter() {
+                let j = j as usize;
+                let mut sum = 0;
+                let s = rule.sample::<true>(Descent::new(u[j]), &mut sum, &mut memo);
+                out[j] = to_light_sample(s).map(|s| (s, self.visibility_at(cut, Some(sum))));
+            }
+        }
+    }
+
     /// Like [`CutRules::sample`] from an `f64` number (53 bits),
     /// returning the unrounded `f64` pmf: equal, bit for bit, to
     /// [`CutRules::pmf_exact`] for the chosen light.
@@ -873,7 +1029,7 @@ impl<H: LightHierarchy> CutRules<H> {
             return None;
         }
         match self.receives(ctx) {
-            None => Rule::new(self, cut, ctx, Unrestricted).sample::<SUM>(d, sum),
+            None => Rule::new(self, cut, ctx, Unrestricted).sample::<SUM>(d, sum, &mut NoMemo),
             Some(r) => self.sample_linked::<SUM>(cut, ctx, d, sum, r),
         }
     }
@@ -889,7 +1045,7 @@ impl<H: LightHierarchy> CutRules<H> {
         sum: &mut usize,
         receives: Receives,
     ) -> Option<(LightId, f64)> {
-        Rule::new(self, cut, ctx, receives).sample::<SUM>(d, sum)
+        Rule::new(self, cut, ctx, receives).sample::<SUM>(d, sum, &mut NoMemo)
     }
 
     /// The light sets `ctx` receives, when they restrict this tree's

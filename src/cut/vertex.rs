@@ -250,6 +250,13 @@ impl<H: LightHierarchy> LightChoice for LightVertex<'_, H> {
     fn sample_with_visibility(&self, u: f32) -> Option<(LightSample, f32)> {
         self.rules.sample_with_visibility(self.cut, &self.ctx, u)
     }
+
+    /// The walks share their common steps
+    /// ([`CutRules::sample_candidates`]).
+    #[inline]
+    fn sample_candidates(&self, u: &[f32], out: &mut [Option<(LightSample, f32)>]) {
+        self.rules.sample_candidates(self.cut, &self.ctx, u, out)
+    }
 }
 
 #[cfg(test)]

@@ -81,6 +81,19 @@ pub trait LightChoice {
         Some((s, self.visibility(s.light)))
     }
 
+    /// Resampling candidates: `out[j]` becomes
+    /// [`LightChoice::sample_with_visibility`]`(u[j])` for every `j` (up
+    /// to the shorter of the two slices), exactly. The default calls it
+    /// once per number; a guide's vertex computes each step the walks
+    /// share once (the candidates of one point pass through the same
+    /// nodes near the root and, where the learned choice is sharp, most
+    /// of the way down), so `M` candidates cost less than `M` samples.
+    fn sample_candidates(&self, u: &[f32], out: &mut [Option<(LightSample, f32)>]) {
+        for (o, &u) in out.iter_mut().zip(u) {
+            *o = self.sample_with_visibility(u);
+        }
+    }
+
     /// [`LightChoice::sample`] with the number drawn from a renderer's
     /// generator: one `next_u32`, its top 24 bits times `2^-24` (in
     /// `[0, 1)`, never 1), so the choice equals `sample` of that number.
@@ -197,5 +210,10 @@ impl<C: LightChoice + ?Sized> LightChoice for &C {
     #[inline]
     fn sample_with_visibility(&self, u: f32) -> Option<(LightSample, f32)> {
         (**self).sample_with_visibility(u)
+    }
+
+    #[inline]
+    fn sample_candidates(&self, u: &[f32], out: &mut [Option<(LightSample, f32)>]) {
+        (**self).sample_candidates(u, out)
     }
 }

@@ -386,3 +386,48 @@ pub use chain::Chain;
 mod flattened;
 #[allow(unused_imports)]
 pub use flattened::Flattened;
+
+/// Checks that `s.sample_candidates` answers each number exactly as
+/// `sample_with_visibility` does (light, pmf and visibility to the bit),
+/// on batches of 0 to 70 numbers (past a sort batch of 64) drawn at
+/// random, sorted, repeated, and with NaN and numbers outside `[0, 1)`,
+/// and that it writes no further than the shorter slice. Returns how many
+/// candidates answered (the caller asserts the check saw something).
+pub fn candidates_match<S: guiding::LightChoice + ?Sized>(s: &S, r: &mut Rand) -> usize {
+    let bits = |c: Option<(guiding::LightSample, f32)>| {
+        c.map(|(x, v)| (x.light, x.pmf.to_bits(), v.to_bits()))
+    };
+    let mut answered = 0;
+    for m in [0usize, 1, 2, 8, 9, 33, 70] {
+        let mut u: Vec<f32> = (0..m).map(|_| r.f()).collect();
+        match m % 3 {
+            0 => u.sort_by(f32::total_cmp),
+            1 if m > 2 => {
+                u[1] = u[0];
+                u[2] = f32::NAN;
+                u[m - 1] = 1.5;
+            }
+            _ => {}
+        }
+        if m > 3 {
+            u[3] = -0.25;
+        }
+        // One slot more than numbers: it must stay as it was.
+        let sentinel = Some((
+            guiding::LightSample {
+                light: guiding::LightId::Emitter(u32::MAX),
+                pmf: 7.0,
+            },
+            7.0,
+        ));
+        let mut out = vec![sentinel; m + 1];
+        s.sample_candidates(&u, &mut out);
+        for (j, &uj) in u.iter().enumerate() {
+            let want = s.sample_with_visibility(uj);
+            assert_eq!(bits(out[j]), bits(want), "candidate {j} of {m}, u = {uj}");
+            answered += usize::from(want.is_some());
+        }
+        assert_eq!(bits(out[m]), bits(sentinel), "wrote past {m} numbers");
+    }
+    answered
+}

@@ -10,8 +10,11 @@
 //! - `sample`: one light sample at a looked-up vertex;
 //! - `pmf-sampled`: the pmf of the light just sampled;
 //! - `pmf-hit`: the pmf of a light a cosine-sampled BSDF ray hit;
-//! - `candidates`: 8 resampling candidates at one vertex
-//!   (`sample_with_visibility`, as `guiding::resample` draws them);
+//! - `candidates`: 8 resampling candidates at one vertex, one
+//!   `sample_with_visibility` each;
+//! - `candidates-shared`: the same 8 in one `sample_candidates` call (as
+//!   `guiding::resample` draws them: a guide's walks share their common
+//!   steps; checked equal, bit for bit, to `candidates`' choices);
 //! - `record`: one light record (the guides only).
 //!
 //! It prints the median time per operation over `--reps` repetitions
@@ -82,10 +85,10 @@ struct Args {
     )]
     samplers: Vec<String>,
     /// Operations, comma-separated (lookup, sample, pmf-sampled, pmf-hit,
-    /// candidates, record).
+    /// candidates, candidates-shared, record).
     #[arg(
         long,
-        default_value = "lookup,sample,pmf-sampled,pmf-hit,candidates,record",
+        default_value = "lookup,sample,pmf-sampled,pmf-hit,candidates,candidates-shared,record",
         value_delimiter = ','
     )]
     ops: Vec<String>,
@@ -109,12 +112,13 @@ struct Args {
 }
 
 /// The operations, in table order.
-const OPS: [&str; 6] = [
+const OPS: [&str; 7] = [
     "lookup",
     "sample",
     "pmf-sampled",
     "pmf-hit",
     "candidates",
+    "candidates-shared",
     "record",
 ];
 
@@ -289,6 +293,18 @@ mod body {
     }
 
     #[inline(always)]
+    pub fn candidates_shared<C: Chooser>(v: &[Option<C::Vertex<'_>>], x: &Inputs) -> usize {
+        let mut out = [None; CANDIDATES];
+        for (v, u) in v.iter().zip(x.uc.chunks_exact(CANDIDATES)) {
+            if let Some(v) = v {
+                v.sample_candidates(black_box(u), &mut out);
+                black_box(&out);
+            }
+        }
+        v.len()
+    }
+
+    #[inline(always)]
     pub fn record<'a, C: Chooser>(
         c: &'a C,
         v: &[Option<C::Vertex<'a>>],
@@ -330,6 +346,13 @@ macro_rules! named_ops {
             #[inline(never)]
             pub fn candidates(v: &[Option<<$ty as Chooser>::Vertex<'_>>], x: &Inputs) -> usize {
                 body::candidates::<$ty>(v, x)
+            }
+            #[inline(never)]
+            pub fn candidates_shared(
+                v: &[Option<<$ty as Chooser>::Vertex<'_>>],
+                x: &Inputs,
+            ) -> usize {
+                body::candidates_shared::<$ty>(v, x)
             }
             #[inline(never)]
             pub fn record<'a>(
@@ -382,6 +405,7 @@ macro_rules! measure {
                     "pmf-sampled" => $m::pmf_sampled(&vertices, &sampled),
                     "pmf-hit" => $m::pmf_hit(&vertices, x),
                     "candidates" => $m::candidates(&vertices, x) * CANDIDATES,
+                    "candidates-shared" => $m::candidates_shared(&vertices, x) * CANDIDATES,
                     _ => $m::record(c, &vertices, &sampled),
                 };
                 times.push(t.elapsed().as_secs_f64());
@@ -423,10 +447,21 @@ fn digest<V: LightChoice>(
             eat(u64::from(v.pmf(light).to_bits()));
         }
     }
+    let mut shared = [None; CANDIDATES];
     for (v, u) in vertices.iter().zip(x.uc.chunks_exact(CANDIDATES)) {
         let Some(v) = v else { continue };
-        for &u in u {
-            if let Some((s, visibility)) = v.sample_with_visibility(u) {
+        v.sample_candidates(u, &mut shared);
+        for (&u, shared) in u.iter().zip(&shared) {
+            let each = v.sample_with_visibility(u);
+            // Shared steps must not change a choice by a bit.
+            let bits = |c: Option<(LightSample, f32)>| {
+                c.map(|(s, v)| (s.light, s.pmf.to_bits(), v.to_bits()))
+            };
+            if bits(each) != bits(*shared) {
+                eprintln!("candidates-shared differs from candidates: {shared:?} against {each:?}");
+                std::process::exit(1);
+            }
+            if let Some((s, visibility)) = each {
                 eat(id(s.light));
                 eat(u64::from(s.pmf.to_bits()) << 32 | u64::from(visibility.to_bits()));
             }
