@@ -941,7 +941,7 @@ impl<H: LightHierarchy> CutRules<H> {
     /// Resampling candidates at `ctx` with `cut`: `out[j]` becomes
     /// [`CutRules::sample_with_visibility`]`(u[j])` for every `j` (up to
     /// the shorter slice), bit for bit, but each step the walks share is
-    /// computed once ([`StepMemo`]), and the walks go in increasing order
+    /// computed once (a memo of each level's last step, by node), and the walks go in increasing order
     /// of their numbers, so consecutive walks share the longest prefixes
     /// (a descent keeps the numbers' order). The mixture and the prepared
     /// point are computed once for all of them.
