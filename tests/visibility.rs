@@ -217,6 +217,35 @@ fn resampling_with_learned_visibility_is_unbiased_and_better() {
     assert!(v1 < 0.8 * v0, "learned visibility {v1}, blind {v0}");
 }
 
+/// A GLT learning visibility in the two rooms from its own NEE samples
+/// (three refinements of 8,000), with `unbounded` lights (the first
+/// hidden half the time).
+fn trained_on_two_rooms(
+    unbounded: guiding::UnboundedLights,
+    lights: &[guiding::Emitter],
+    rng: &mut Rand,
+) -> Glt<&'static LightTree> {
+    let mut cfg = config(true);
+    cfg.cut.unbounded = unbounded;
+    let mut glt = Glt::new(tree(), scene(), cfg).unwrap();
+    for _ in 0..3 {
+        for _ in 0..8000 {
+            let p = rng.point(9.5);
+            let Some(x) = ByPosition(&glt).sample(&ShadingContext::at(p), rng.f()) else {
+                continue;
+            };
+            let (seen, open) = match x.light {
+                LightId::Emitter(e) => (value(lights, e, p), unshadowed(lights, e, p)),
+                LightId::Unbounded(i) => (if i == 0 && rng.f() < 0.5 { 0.0 } else { 1.0 }, 1.0),
+            };
+            glt.record_light_at(p, x.light, seen / x.pmf);
+            glt.record_visibility_at(p, x.light, seen / x.pmf, open / x.pmf);
+        }
+        glt.refine();
+    }
+    glt
+}
+
 /// `sample_with_visibility` (the visibility read where the walk leaves the
 /// cut) answers exactly as `sample` and then `visibility` (the light's
 /// path walked again), for the GLT, its vertex and one cell's cut as a
@@ -229,26 +258,8 @@ fn sampling_with_visibility_equals_sampling_then_visibility() {
         guiding::UnboundedLights::NONE,
         guiding::UnboundedLights::new(2, 0.2).unwrap(),
     ] {
-        let mut cfg = config(true);
-        cfg.cut.unbounded = unbounded;
-        let mut glt = Glt::new(tree(), scene(), cfg).unwrap();
         let mut rng = Rand::new(77);
-        for _ in 0..3 {
-            for _ in 0..8000 {
-                let p = rng.point(9.5);
-                let Some(x) = ByPosition(&glt).sample(&ShadingContext::at(p), rng.f()) else {
-                    continue;
-                };
-                let (seen, open) = match x.light {
-                    LightId::Emitter(e) => (value(&lights, e, p), unshadowed(&lights, e, p)),
-                    // The first unbounded light is hidden half the time.
-                    LightId::Unbounded(i) => (if i == 0 && rng.f() < 0.5 { 0.0 } else { 1.0 }, 1.0),
-                };
-                glt.record_light_at(p, x.light, seen / x.pmf);
-                glt.record_visibility_at(p, x.light, seen / x.pmf, open / x.pmf);
-            }
-            glt.refine();
-        }
+        let glt = trained_on_two_rooms(unbounded, &lights, &mut rng);
         let (mut draws, mut learned) = (0, 0);
         for _ in 0..3000 {
             let p = rng.point(9.5);
@@ -288,24 +299,7 @@ fn candidates_drawn_together_are_the_candidates_drawn_alone() {
         guiding::UnboundedLights::NONE,
         guiding::UnboundedLights::new(2, 0.2).unwrap(),
     ] {
-        let mut cfg = config(true);
-        cfg.cut.unbounded = unbounded;
-        let mut glt = Glt::new(tree(), scene(), cfg).unwrap();
-        for _ in 0..3 {
-            for _ in 0..8000 {
-                let p = rng.point(9.5);
-                let Some(x) = ByPosition(&glt).sample(&ShadingContext::at(p), rng.f()) else {
-                    continue;
-                };
-                let (seen, open) = match x.light {
-                    LightId::Emitter(e) => (value(&lights, e, p), unshadowed(&lights, e, p)),
-                    LightId::Unbounded(i) => (if i == 0 && rng.f() < 0.5 { 0.0 } else { 1.0 }, 1.0),
-                };
-                glt.record_light_at(p, x.light, seen / x.pmf);
-                glt.record_visibility_at(p, x.light, seen / x.pmf, open / x.pmf);
-            }
-            glt.refine();
-        }
+        let glt = trained_on_two_rooms(unbounded, &lights, &mut rng);
         let mut answered = 0;
         for _ in 0..200 {
             let ctx = ShadingContext::on_surface(rng.point(9.5), rng.dir());
