@@ -7,6 +7,7 @@ use guiding::glam::Vec3;
 use guiding::{BuildHeuristic, Emitter};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyBytes;
 use std::sync::Arc;
 
 /// A scene's emitters, in the order their light indices count: each
@@ -242,6 +243,31 @@ impl LightTree {
     #[getter]
     fn nbytes(&self) -> usize {
         self.tree.bytes()
+    }
+
+    /// The tree as bytes (`LightTree.from_bytes` reads them back): what a
+    /// farm sends its workers once, instead of the emitters to rebuild from.
+    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
+        PyBytes::new(py, &self.tree.to_bytes())
+    }
+
+    /// A tree saved by `to_bytes`; `ValueError` for bytes that are not one.
+    #[staticmethod]
+    fn from_bytes(py: Python<'_>, data: &[u8]) -> PyResult<Self> {
+        let tree = py
+            .detach(|| guiding::LightTree::from_bytes(data))
+            .map_err(value_error)?;
+        Ok(Self {
+            tree: Arc::new(tree),
+        })
+    }
+
+    /// Pickling (dask, multiprocessing) goes through the bytes.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyBytes>,))> {
+        let from_bytes = slf.get_type().getattr("from_bytes")?;
+        Ok((from_bytes, (slf.get().to_bytes(slf.py()),)))
     }
 
     fn __repr__(&self) -> String {

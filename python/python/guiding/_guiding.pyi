@@ -84,6 +84,10 @@ class LightTree:
     def bounds(self) -> Tuple[Tuple[float, float, float], Tuple[float, float, float]]: ...
     @property
     def nbytes(self) -> int: ...
+    def to_bytes(self) -> bytes:
+        """What a farm sends its workers once (pickling goes through it)."""
+    @staticmethod
+    def from_bytes(data: bytes) -> "LightTree": ...
 
 class _Guide:
     """What every guide has (not a class of the module)."""
