@@ -8,6 +8,9 @@ samples and at equal time:
 - `path-power`: Mitsuba's `path`, `sampling_weight` = each emitter's power;
 - `glt`: `glt_path` (integrator.py), the crate's GLT over every emissive
   triangle, trained for a few passes first (their time counted);
+- `glt-ppg`: `glt_path` with a `GuidingField`: the same GLT light choice,
+  and the path's directions from PPG's SD-tree in the same field (trained
+  in the same passes);
 - `glt-uniform`: `glt_path` choosing uniformly among the same lights, the
   wavefront's own check (its mean must agree too).
 
@@ -136,7 +139,7 @@ class Glt(Method):
         self.integ.render_image(self.scene, 1, seed=2)
         t0 = time.perf_counter()
         self.integ.attach(self.scene)
-        if self.integ.choice == "glt":
+        if self.integ.choice != "uniform":
             for i, spp in enumerate(TRAIN_SPP):
                 self.integ.render_image(self.scene, spp, seed=10 + i, record=True)
                 self.integ.guide.refine()
@@ -214,13 +217,13 @@ def sheet(path, images, labels):
     out.save(path)
 
 
-def bounce_timing(scene_dict, width, height, spp):
-    """Where a `glt` bounce's time goes at `width` x `height`: seconds per
-    part over a render of `spp`, after a warm-up."""
+def bounce_timing(scene_dict, width, height, spp, choice="glt"):
+    """Where a `glt_path` bounce's time goes at `width` x `height`: seconds
+    per part over a render of `spp`, after a warm-up."""
     d = dict(scene_dict)
     d["sensor"] = dict(d["sensor"], film=dict(d["sensor"]["film"], width=width, height=height))
     scene = mi.load_dict(d)
-    m = Glt("glt", scene, "glt")
+    m = Glt(choice, scene, choice)
     m.prepare()
     m.integ.render_image(scene, spp, seed=1)
     m.integ.timer = glt_integrator.Timer()
@@ -244,6 +247,7 @@ def compare(name, args):
         Mitsuba("path", uniform),
         Mitsuba("path-power", power),
         Glt("glt", uniform, "glt"),
+        Glt("glt-ppg", uniform, "field"),
         Glt("glt-uniform", uniform, "uniform"),
     ]
     # Warm-up: Dr.Jit compiles each kernel once (and caches it on disk).
@@ -280,13 +284,14 @@ def compare(name, args):
         agree=all(v["agrees"] for k, v in rows.items() if k.startswith("glt")),
     )
     if not args.quick:
-        report["bounce_seconds_256"] = bounce_timing(d, 256, 256, 4)
+        report["bounce_seconds_256"] = {k: bounce_timing(d, 256, 256, 4, c) for k, c in (("glt", "glt"), ("glt-ppg", "field"))}
     if args.sheet:
         os.makedirs(args.sheet, exist_ok=True)
         sheet(
             os.path.join(args.sheet, f"mitsuba3-{name}.png"),
-            [ref] + [rows[k]["image"] for k in ("path", "path-power", "glt")],
-            [f"reference ({args.reference_spp} spp)"] + [f"{k}, {args.seconds:.0f} s" for k in ("path", "path-power", "glt")],
+            [ref] + [rows[k]["image"] for k in ("path", "path-power", "glt", "glt-ppg")],
+            [f"reference ({args.reference_spp} spp)"]
+            + [f"{k}, {args.seconds:.0f} s" for k in ("path", "path-power", "glt", "glt-ppg")],
         )
     print(f"\n{name}: {lights.light_count} lights ({len(uniform.emitters())} Mitsuba emitters), "
           f"{args.width}x{args.height}, reference {os.path.basename(ref_path)} (mean {ref.mean():.5f}, own relMSE {ref_relmse:.2e})")
@@ -297,9 +302,9 @@ def compare(name, args):
               f"{t['efficiency']:>9.3g} {t['efficiency'] / base:>7.2f}x {t['efficiency'] / base2:>7.2f}x | "
               f"{v['mean']:.5f} +- {v['mean_err']:.5f}{'' if v['agrees'] else '  DISAGREES with the reference'}")
     if "bounce_seconds_256" in report:
-        parts = report["bounce_seconds_256"]
-        total = sum(parts.values())
-        print("glt at 256x256, 4 spp: " + ", ".join(f"{k} {v:.2f} s ({100 * v / total:.0f}%)" for k, v in parts.items()))
+        for method, parts in report["bounce_seconds_256"].items():
+            total = sum(parts.values())
+            print(f"{method} at 256x256, 4 spp: " + ", ".join(f"{k} {v:.2f} s ({100 * v / total:.0f}%)" for k, v in parts.items()))
     return report
 
 
@@ -332,7 +337,8 @@ def main():
             m = r["methods"]
             e = {k: v["equal_time"]["efficiency"] for k, v in m.items()}
             print(f"{r['scene']}: glt efficiency {e['glt'] / e['path-power']:.2f}x Mitsuba's path with power weights, "
-                  f"{e['glt'] / e['path']:.2f}x with its uniform choice")
+                  f"{e['glt'] / e['path']:.2f}x with its uniform choice; glt-ppg {e['glt-ppg'] / e['path-power']:.2f}x, "
+                  f"{e['glt-ppg'] / e['path']:.2f}x")
     if failed:
         sys.exit(f"means disagree with the reference on: {', '.join(failed)}")
 
