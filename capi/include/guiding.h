@@ -457,6 +457,38 @@ enum GuidingStatus guiding_glt_pmf(const struct GuidingGlt *glt,
                                    float *out);
 
 /*
+ `guiding_glt_sample` for `count` shading points at once: `ctx[i]` with
+ `u[i]` into `out[i]` (a wavefront renderer's batch; the guide's lock is
+ taken once for the batch). Every input is checked before anything is
+ written: on failure `out` is untouched and the message names the first
+ bad element.
+
+ # Safety
+ `glt` a live handle; `ctx`, `u` `count` readable elements each; `out`
+ `count` writable elements.
+ */
+enum GuidingStatus guiding_glt_sample_batch(const struct GuidingGlt *glt,
+                                            const struct GuidingShadingContext *ctx,
+                                            const float *u,
+                                            size_t count,
+                                            struct GuidingLightSample *out);
+
+/*
+ `guiding_glt_pmf` for `count` shading points at once: the pmf of
+ `light[i]` at `ctx[i]` into `out[i]` (the lock taken once). Every input
+ is checked before anything is written.
+
+ # Safety
+ `glt` a live handle; `ctx`, `light` `count` readable elements each;
+ `out` `count` writable floats.
+ */
+enum GuidingStatus guiding_glt_pmf_batch(const struct GuidingGlt *glt,
+                                         const struct GuidingShadingContext *ctx,
+                                         const uint32_t *light,
+                                         size_t count,
+                                         float *out);
+
+/*
  Records a light sample's estimate at `ctx`: `value` is what the sample
  of `light` contributed, MIS-weighted and divided by its pdf, without the
  BSDF and the cosine (from NEE `Le * T * w_mis / (pmf *

@@ -308,6 +308,119 @@ pub unsafe extern "C" fn guiding_glt_pmf(
     })
 }
 
+/// `guiding_glt_sample` for `count` shading points at once: `ctx[i]` with
+/// `u[i]` into `out[i]` (a wavefront renderer's batch; the guide's lock is
+/// taken once for the batch). Every input is checked before anything is
+/// written: on failure `out` is untouched and the message names the first
+/// bad element.
+///
+/// # Safety
+/// `glt` a live handle; `ctx`, `u` `count` readable elements each; `out`
+/// `count` writable elements.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn guiding_glt_sample_batch(
+    glt: *const GuidingGlt,
+    ctx: *const GuidingShadingContext,
+    u: *const f32,
+    count: usize,
+    out: *mut GuidingLightSample,
+) -> GuidingStatus {
+    guard(|| {
+        // SAFETY: forwarded.
+        let (g, ctx, u) = unsafe {
+            (
+                get(glt, "glt")?,
+                slice(ctx, count, "ctx")?,
+                slice(u, count, "u")?,
+            )
+        };
+        if count > 0 && out.is_null() {
+            return Err(Failure::null("out"));
+        }
+        let contexts = ctx
+            .iter()
+            .zip(u)
+            .enumerate()
+            .map(|(i, (c, &u))| {
+                let c = c
+                    .to_rust()
+                    .map_err(|f| Failure::invalid(format!("ctx[{i}]: {}", f.message)))?;
+                if !(0.0..1.0).contains(&u) {
+                    return Err(Failure::invalid(format!("u[{i}] = {u} is not in [0, 1)")));
+                }
+                Ok((c, u))
+            })
+            .collect::<Result<Vec<_>, Failure>>()?;
+        let guide = g.read()?;
+        for (i, (c, u)) in contexts.iter().enumerate() {
+            let s = guide.vertex(c).and_then(|v| v.sample(*u)).map_or(
+                GuidingLightSample {
+                    light: GUIDING_NO_LIGHT,
+                    pmf: 0.0,
+                },
+                |s| GuidingLightSample {
+                    light: s.light.index(g.emitters),
+                    pmf: s.pmf,
+                },
+            );
+            // SAFETY: `out` holds `count` writable elements (the caller's promise), i < count.
+            unsafe { out.add(i).write(s) };
+        }
+        Ok(())
+    })
+}
+
+/// `guiding_glt_pmf` for `count` shading points at once: the pmf of
+/// `light[i]` at `ctx[i]` into `out[i]` (the lock taken once). Every input
+/// is checked before anything is written.
+///
+/// # Safety
+/// `glt` a live handle; `ctx`, `light` `count` readable elements each;
+/// `out` `count` writable floats.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn guiding_glt_pmf_batch(
+    glt: *const GuidingGlt,
+    ctx: *const GuidingShadingContext,
+    light: *const u32,
+    count: usize,
+    out: *mut f32,
+) -> GuidingStatus {
+    guard(|| {
+        // SAFETY: forwarded.
+        let (g, ctx, light) = unsafe {
+            (
+                get(glt, "glt")?,
+                slice(ctx, count, "ctx")?,
+                slice(light, count, "light")?,
+            )
+        };
+        if count > 0 && out.is_null() {
+            return Err(Failure::null("out"));
+        }
+        let queries = ctx
+            .iter()
+            .zip(light)
+            .enumerate()
+            .map(|(i, (c, &l))| {
+                let c = c
+                    .to_rust()
+                    .map_err(|f| Failure::invalid(format!("ctx[{i}]: {}", f.message)))?;
+                let l = g
+                    .light(l)
+                    .map_err(|f| Failure::invalid(format!("light[{i}]: {}", f.message)))?;
+                Ok((c, l))
+            })
+            .collect::<Result<Vec<_>, Failure>>()?;
+        let guide = g.read()?;
+        for (i, (c, l)) in queries.iter().enumerate() {
+            let p = guide.vertex(c).map_or(0.0, |v| v.pmf(*l));
+            // SAFETY: `out` holds `count` writable floats (the caller's promise), i < count.
+            unsafe { out.add(i).write(p) };
+        }
+        Ok(())
+    })
+}
+
 /// Records a light sample's estimate at `ctx`: `value` is what the sample
 /// of `light` contributed, MIS-weighted and divided by its pdf, without the
 /// BSDF and the cosine (from NEE `Le * T * w_mis / (pmf *

@@ -186,6 +186,38 @@ int main(void) {
         CHECK(fabs(sum - 1.0) < 1e-5, "pmfs sum to %.9f", sum);
     }
 
+    /* The batched calls answer what the single ones do; a bad element is
+       refused before anything is written. */
+    {
+        enum { N = 64 };
+        GuidingShadingContext cs[N];
+        float us[N], pmfs[N];
+        uint32_t ls[N];
+        GuidingLightSample out[N];
+        rng_state = 21;
+        for (int i = 0; i < N; i++) {
+            cs[i] = point_on_floor();
+            us[i] = next_float() * 0.999999f;
+        }
+        OK(guiding_glt_sample_batch(glt, cs, us, N, out));
+        for (int i = 0; i < N; i++) {
+            GuidingLightSample one;
+            OK(guiding_glt_sample(glt, &cs[i], us[i], &one));
+            CHECK(one.light == out[i].light && one.pmf == out[i].pmf, "batch %d differs", i);
+            ls[i] = out[i].light;
+        }
+        OK(guiding_glt_pmf_batch(glt, cs, ls, N, pmfs));
+        for (int i = 0; i < N; i++) CHECK(pmfs[i] == out[i].pmf, "batch pmf %d: %g against %g", i, pmfs[i], out[i].pmf);
+        us[N - 1] = NAN;
+        out[0].light = 12345;
+        CHECK(guiding_glt_sample_batch(glt, cs, us, N, out) == GUIDING_STATUS_INVALID_ARGUMENT, "NaN in a batch");
+        CHECK(strstr(guiding_last_error(), "u[63]") != NULL, "message %s", guiding_last_error());
+        CHECK(out[0].light == 12345, "out written before the batch was checked");
+        ls[5] = LIGHTS;
+        CHECK(guiding_glt_pmf_batch(glt, cs, ls, N, pmfs) == GUIDING_STATUS_INVALID_ARGUMENT, "light out of range in a batch");
+        OK(guiding_glt_sample_batch(glt, NULL, NULL, 0, NULL)); /* an empty batch */
+    }
+
     /* The learned choice sees the wall: from x < 5, lights beyond it get
        less than their unguided share. */
     {
