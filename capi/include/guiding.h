@@ -65,8 +65,9 @@
 
 /*
  What a call did. `GUIDING_STATUS_OK` is 0; on anything else
- [`guiding_last_error`] holds the reason and every output is left as it
- was.
+ [`guiding_last_error`] holds the reason and the outputs are left as
+ they were (but for `guiding_glt_record_light`'s outcome, which says
+ the record was dropped).
  */
 typedef enum GuidingStatus {
   /*

@@ -6,8 +6,9 @@ use std::ffi::{CString, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// What a call did. `GUIDING_STATUS_OK` is 0; on anything else
-/// [`guiding_last_error`] holds the reason and every output is left as it
-/// was.
+/// [`guiding_last_error`] holds the reason and the outputs are left as
+/// they were (but for `guiding_glt_record_light`'s outcome, which says
+/// the record was dropped).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum GuidingStatus {
