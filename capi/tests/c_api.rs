@@ -1,7 +1,9 @@
 //! The C API from C: `tests/c/glt_test.c` built with the system's C
 //! compiler against the static library, run (under valgrind's memcheck
 //! when it is installed: no error, no leak), and the header compiled as
-//! C99 and as C++17 with every warning an error.
+//! C99 and as C++17 with every warning an error; `tests/cpp/nee_test.cpp`
+//! drives a renderer's NEE through the C++ wrapper (`include/guiding.hpp`)
+//! from four threads, under valgrind the same way.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -68,6 +70,43 @@ fn the_c_program_trains_checks_saves_loads_and_merges() {
             "-g",
         ])
         .arg(dir.join("tests/c/glt_test.c"))
+        .arg("-I")
+        .arg(dir.join("include"))
+        .arg(lib.join("libguiding_c.a"))
+        .args(["-lpthread", "-ldl", "-lm", "-o"])
+        .arg(&exe));
+    let out = if on_path("valgrind") {
+        run(Command::new("valgrind")
+            .args([
+                "--error-exitcode=3",
+                "--leak-check=full",
+                "--errors-for-leak-kinds=definite,indirect",
+                "--quiet",
+            ])
+            .arg(&exe))
+    } else {
+        run(&mut Command::new(&exe))
+    };
+    assert!(out.contains("every check passed"), "{out}");
+}
+
+#[test]
+fn the_cpp_wrapper_drives_a_renderers_nee_from_four_threads() {
+    let lib = library_dir();
+    let exe = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("nee_test");
+    let dir = crate_dir();
+    run(Command::new("c++")
+        .args([
+            "-std=c++17",
+            "-Wall",
+            "-Wextra",
+            "-Werror",
+            "-pedantic",
+            "-O1",
+            "-g",
+            "-pthread",
+        ])
+        .arg(dir.join("tests/cpp/nee_test.cpp"))
         .arg("-I")
         .arg(dir.join("include"))
         .arg(lib.join("libguiding_c.a"))

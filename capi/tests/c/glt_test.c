@@ -93,8 +93,8 @@ int main(void) {
         const float corner[3] = {10.0f * (float)(i % GRID) / GRID, 3.0f, 10.0f * (float)(i / GRID) / GRID};
         const float eu[3] = {0.2f, 0, 0}, ev[3] = {0, 0, 0.2f};
         uint32_t index = 0;
-        /* Facing down: edge_v x edge_u points to -y. */
-        OK(guiding_emitters_add_quad(emitters, corner, ev, eu, 1.0f + (float)(i % 7), false, &index));
+        /* Facing down, to the floor: edge_u x edge_v points to -y. */
+        OK(guiding_emitters_add_quad(emitters, corner, eu, ev, 1.0f + (float)(i % 7), false, &index));
         CHECK(index == (uint32_t)i, "index %u", index);
         memcpy(positions[i], corner, sizeof corner);
     }
