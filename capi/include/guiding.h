@@ -17,6 +17,35 @@
 #include <stdbool.h>
 
 /*
+ A spatial filter: a record goes to its point's cell.
+ */
+#define GUIDING_FILTER_NEAREST 0
+
+/*
+ A spatial filter: a record goes to one cell picked within a cell-sized
+ box around it.
+ */
+#define GUIDING_FILTER_STOCHASTIC_BOX 1
+
+/*
+ A spatial filter: a record is spread over the cells a cell-sized box
+ around it overlaps.
+ */
+#define GUIDING_FILTER_BOX 2
+
+/*
+ A directional filter: a record goes to the quadtree leaf of its
+ direction.
+ */
+#define GUIDING_DIRECTIONAL_NEAREST 0
+
+/*
+ A directional filter: a record is spread over the leaves a leaf-sized
+ box around its direction overlaps.
+ */
+#define GUIDING_DIRECTIONAL_BOX 1
+
+/*
  `GuidingShadingContext::light_sets` and `unbounded_lights` for a point
  lit by every light (no light linking).
  */
@@ -26,21 +55,6 @@
  `GuidingLightSample::light` when nothing can be sampled (its pmf is 0).
  */
 #define GUIDING_NO_LIGHT UINT32_MAX
-
-/*
- `light_filter` of `GuidingGltConfig`: a record goes to its point's cell.
- */
-#define GUIDING_FILTER_NEAREST 0
-
-/*
- A record goes to one cell picked within a cell-sized box around it.
- */
-#define GUIDING_FILTER_STOCHASTIC_BOX 1
-
-/*
- A record is spread over the cells a cell-sized box around it overlaps.
- */
-#define GUIDING_FILTER_BOX 2
 
 /*
  `heuristic` of `guiding_light_tree_build`: the surface-area-radiance
@@ -140,7 +154,15 @@ typedef enum GuidingRecordOutcome {
 typedef struct GuidingEmitters GuidingEmitters;
 
 /*
- A Guiding Light Tree (opaque).
+ The combined field (opaque): a light choice and directional guiding per
+ region. Queries and records may run from many threads at once; refine,
+ clear_records and merge wait for them.
+ */
+typedef struct GuidingField GuidingField;
+
+/*
+ A Guiding Light Tree (opaque). Queries and records may run from many
+ threads at once; refine, clear_records and merge wait for them.
  */
 typedef struct GuidingGlt GuidingGlt;
 
@@ -149,6 +171,13 @@ typedef struct GuidingGlt GuidingGlt;
  be freed before them.
  */
 typedef struct GuidingLightTree GuidingLightTree;
+
+/*
+ An SD-tree (opaque): learned directional distributions per region.
+ Queries and records may run from many threads at once; refine,
+ clear_records and merge wait for them.
+ */
+typedef struct GuidingSdTree GuidingSdTree;
 
 /*
  Bytes owned by the crate: `len` bytes at `data`. Free with
@@ -166,11 +195,10 @@ typedef struct GuidingBuffer {
 } GuidingBuffer;
 
 /*
- The GLT's configuration (the Rust `GltConfig`'s renderer-facing
- fields). Start from `guiding_glt_config_default`; `guiding_glt_new`
- refuses values out of range with `GUIDING_STATUS_INVALID_CONFIG`.
+ The learned cut's configuration (the Rust `CutConfig`'s
+ renderer-facing fields), shared by the GLT and the field.
  */
-typedef struct GuidingGltConfig {
+typedef struct GuidingCutConfig {
   /*
    The cut's refinement threshold (the paper's sigma).
    */
@@ -195,10 +223,16 @@ typedef struct GuidingGltConfig {
    The probability of choosing one of them (with `unbounded_lights` > 0).
    */
   double unbounded_probability;
+} GuidingCutConfig;
+
+/*
+ The GLT's configuration.
+ */
+typedef struct GuidingGltConfig {
   /*
-   Learned state bit for bit the same whatever the thread count.
+   The cuts'.
    */
-  bool deterministic;
+  struct GuidingCutConfig cut;
   /*
    Records a spatial cell takes before it splits.
    */
@@ -211,7 +245,77 @@ typedef struct GuidingGltConfig {
    Where a light record goes: a `GUIDING_FILTER_*`.
    */
   uint32_t light_filter;
+  /*
+   Learned state bit for bit the same whatever the thread count.
+   */
+  bool deterministic;
 } GuidingGltConfig;
+
+/*
+ The SD-tree's configuration (Practical Path Guiding's).
+ */
+typedef struct GuidingSdTreeConfig {
+  /*
+   Records a spatial cell takes before it splits (PPG's c).
+   */
+  double spatial_threshold;
+  /*
+   The most bytes the tree may take; 0 for no limit.
+   */
+  size_t max_bytes;
+  /*
+   A quadtree leaf splits above this share of its energy (PPG's rho).
+   */
+  float rho;
+  /*
+   The quadtrees' deepest level.
+   */
+  uint32_t max_depth;
+  /*
+   Where a radiance record goes in space: a `GUIDING_FILTER_*`.
+   */
+  uint32_t spatial_filter;
+  /*
+   ... and in direction: a `GUIDING_DIRECTIONAL_*`.
+   */
+  uint32_t directional_filter;
+  /*
+   The probability of sampling the BSDF rather than the guide (the
+   starting value when it is learned).
+   */
+  float bsdf_fraction;
+  /*
+   Learn the BSDF fraction per cell (from fraction records).
+   */
+  bool learn_bsdf_fraction;
+  /*
+   Optimisation steps of the learned fraction per record.
+   */
+  uint32_t fraction_steps;
+  /*
+   Learned state bit for bit the same whatever the thread count.
+   */
+  bool deterministic;
+} GuidingSdTreeConfig;
+
+/*
+ The combined field's configuration: its SD-tree's (whose spatial
+ threshold and `deterministic` the whole field follows) and its cuts'.
+ */
+typedef struct GuidingFieldConfig {
+  /*
+   The SD-tree's (`deterministic` sets both halves).
+   */
+  struct GuidingSdTreeConfig sd;
+  /*
+   The cuts'.
+   */
+  struct GuidingCutConfig cut;
+  /*
+   Where a light record goes: a `GUIDING_FILTER_*`.
+   */
+  uint32_t light_filter;
+} GuidingFieldConfig;
 
 /*
  The shading point a light is chosen for (the Rust `ShadingContext`).
@@ -256,7 +360,21 @@ typedef struct GuidingLightSample {
 } GuidingLightSample;
 
 /*
- What `guiding_glt_refine` did to the spatial tree.
+ A direction the guide sampled and its solid-angle pdf.
+ */
+typedef struct GuidingDirectionSample {
+  /*
+   The unit direction (world space).
+   */
+  float direction[3];
+  /*
+   Its solid-angle pdf (exactly what the `_direction_pdf` call gives).
+   */
+  float pdf;
+} GuidingDirectionSample;
+
+/*
+ What a `_refine` call did to the spatial tree.
  */
 typedef struct GuidingRefineOutcome {
   /*
@@ -285,6 +403,40 @@ extern "C" {
  `buffer` null or a buffer a `guiding_*_save` call filled, not freed yet.
  */
 enum GuidingStatus guiding_buffer_free(struct GuidingBuffer *buffer);
+
+/*
+ The crate's default GLT configuration, written to `out`.
+
+ # Safety
+ `out` null or writable.
+ */
+enum GuidingStatus guiding_glt_config_default(struct GuidingGltConfig *out);
+
+/*
+ The crate's default SD-tree configuration (PPG's original settings),
+ written to `out`.
+
+ # Safety
+ `out` null or writable.
+ */
+enum GuidingStatus guiding_sd_tree_config_default(struct GuidingSdTreeConfig *out);
+
+/*
+ Müller's improved SD-tree settings (c = 4,000, jittered records, a
+ learned BSDF fraction), written to `out`.
+
+ # Safety
+ `out` null or writable.
+ */
+enum GuidingStatus guiding_sd_tree_config_improved(struct GuidingSdTreeConfig *out);
+
+/*
+ The crate's default field configuration, written to `out`.
+
+ # Safety
+ `out` null or writable.
+ */
+enum GuidingStatus guiding_field_config_default(struct GuidingFieldConfig *out);
 
 /*
  A new, empty list of emitters, written to `out`.
@@ -394,12 +546,258 @@ enum GuidingStatus guiding_emitters_add_disk(struct GuidingEmitters *emitters,
                                              uint32_t *index);
 
 /*
- The crate's default configuration, written to `out`.
+ A field over `tree` for shading points in the box `lower[3]`..`upper[3]`,
+ with `config` (null: the defaults), written to `out`.
 
  # Safety
- `out` writable.
+ `tree` a live handle; `lower`, `upper` 3 floats each; `config` null or
+ readable; `out` writable.
  */
-enum GuidingStatus guiding_glt_config_default(struct GuidingGltConfig *out);
+enum GuidingStatus guiding_field_new(const struct GuidingLightTree *tree,
+                                     const float *lower,
+                                     const float *upper,
+                                     const struct GuidingFieldConfig *config,
+                                     struct GuidingField **out);
+
+/*
+ A field saved by `guiding_field_save`, over `tree` (the light tree it
+ was saved over), from `len` bytes at `data`;
+ `GUIDING_STATUS_LOAD_FAILED` for bytes that are not one or another tree.
+
+ # Safety
+ `tree` a live handle; `data` `len` readable bytes; `out` writable.
+ */
+enum GuidingStatus guiding_field_load(const struct GuidingLightTree *tree,
+                                      const uint8_t *data,
+                                      size_t len,
+                                      struct GuidingField **out);
+
+/*
+ Frees `field` (null is allowed and does nothing).
+
+ # Safety
+ `field` null or a live handle, freed once, with no call on it running.
+ */
+void guiding_field_free(struct GuidingField *field);
+
+/*
+ The refinements so far (0 for null).
+
+ # Safety
+ `field` null or a live handle.
+ */
+uint32_t guiding_field_iteration(const struct GuidingField *field);
+
+/*
+ The records dropped as bad input so far, every reason together (0 for
+ null).
+
+ # Safety
+ `field` null or a live handle.
+ */
+uint64_t guiding_field_dropped_records(const struct GuidingField *field);
+
+/*
+ How many lights `field` chooses among: its emitters, then its unbounded
+ lights (0 for null).
+
+ # Safety
+ `field` null or a live handle.
+ */
+uint32_t guiding_field_light_count(const struct GuidingField *field);
+
+/*
+ Chooses a light at `ctx` with `u` in [0, 1): its index and pmf in
+ `out` (`GUIDING_NO_LIGHT` and 0 when nothing can be sampled there).
+
+ # Safety
+ `field` a live handle; `ctx` readable; `out` writable.
+ */
+enum GuidingStatus guiding_field_sample(const struct GuidingField *field,
+                                        const struct GuidingShadingContext *ctx,
+                                        float u,
+                                        struct GuidingLightSample *out);
+
+/*
+ The probability that `guiding_field_sample` at `ctx` chooses `light` (for
+ MIS with a BSDF sample that hit it), in `out`; exactly the sample's pmf.
+
+ # Safety
+ `field` a live handle; `ctx` readable; `out` writable.
+ */
+enum GuidingStatus guiding_field_pmf(const struct GuidingField *field,
+                                     const struct GuidingShadingContext *ctx,
+                                     uint32_t light,
+                                     float *out);
+
+/*
+ `guiding_field_sample` for `count` points at once: `ctx[i]` with `u[i]` into
+ `out[i]` (a wavefront's batch; the guide's lock taken once). Every input
+ is checked before anything is written; the message names the first bad
+ element.
+
+ # Safety
+ `field` a live handle; `ctx`, `u` `count` readable elements; `out` `count` writable.
+ */
+enum GuidingStatus guiding_field_sample_batch(const struct GuidingField *field,
+                                              const struct GuidingShadingContext *ctx,
+                                              const float *u,
+                                              size_t count,
+                                              struct GuidingLightSample *out);
+
+/*
+ `guiding_field_pmf` for `count` points at once: the pmf of `light[i]` at
+ `ctx[i]` into `out[i]`. Every input is checked before anything is written.
+
+ # Safety
+ `field` a live handle; `ctx`, `light` `count` readable elements; `out` `count` writable floats.
+ */
+enum GuidingStatus guiding_field_pmf_batch(const struct GuidingField *field,
+                                           const struct GuidingShadingContext *ctx,
+                                           const uint32_t *light,
+                                           size_t count,
+                                           float *out);
+
+/*
+ Records a light sample's estimate at `ctx`: `value` is what the sample
+ of `light` contributed, MIS-weighted and divided by its pdf, without the
+ BSDF and the cosine (from NEE `Le * T * w_mis / (pmf *
+ pdf_solid_angle)`, 0 when occluded; from a BSDF sample that hit the
+ emitter `Le * w_mis / pdf_direction`), one scalar such as luminance,
+ finite and >= 0. What the record did goes to `outcome` (null allowed).
+ A NaN, infinite or negative `value` is `GUIDING_STATUS_INVALID_ARGUMENT`,
+ and the guide counts it among its dropped records.
+
+ # Safety
+ `field` a live handle; `ctx` readable; `outcome` null or writable.
+ */
+enum GuidingStatus guiding_field_record_light(const struct GuidingField *field,
+                                              const struct GuidingShadingContext *ctx,
+                                              uint32_t light,
+                                              float value,
+                                              enum GuidingRecordOutcome *outcome);
+
+/*
+ A direction from the guide's distribution at `ctx` with `u[2]` in
+ [0, 1): the unit direction and its solid-angle pdf in `out`.
+
+ # Safety
+ `field` a live handle; `ctx` readable; `u` 2 floats; `out` writable.
+ */
+enum GuidingStatus guiding_field_sample_direction(const struct GuidingField *field,
+                                                  const struct GuidingShadingContext *ctx,
+                                                  const float *u,
+                                                  struct GuidingDirectionSample *out);
+
+/*
+ The guide's solid-angle pdf of `direction[3]` (any length but 0) at
+ `ctx`, in `out`.
+
+ # Safety
+ `field` a live handle; `ctx` readable; `direction` 3 floats; `out` writable.
+ */
+enum GuidingStatus guiding_field_direction_pdf(const struct GuidingField *field,
+                                               const struct GuidingShadingContext *ctx,
+                                               const float *direction,
+                                               float *out);
+
+/*
+ The probability of sampling the BSDF rather than the guide at `ctx`
+ (PPG's one-sample mixture), in `out`.
+
+ # Safety
+ `field` a live handle; `ctx` readable; `out` writable.
+ */
+enum GuidingStatus guiding_field_bsdf_fraction(const struct GuidingField *field,
+                                               const struct GuidingShadingContext *ctx,
+                                               float *out);
+
+/*
+ The mixture's pdf of `direction[3]` at `ctx` given the BSDF's
+ `bsdf_pdf` of it: `a bsdf_pdf + (1 - a) guide_pdf`, in `out`.
+
+ # Safety
+ `field` a live handle; `ctx` readable; `direction` 3 floats; `out` writable.
+ */
+enum GuidingStatus guiding_field_mixture_pdf(const struct GuidingField *field,
+                                             const struct GuidingShadingContext *ctx,
+                                             const float *direction,
+                                             float bsdf_pdf,
+                                             float *out);
+
+/*
+ PPG's record: `radiance` (one scalar, finite and >= 0) arrived at
+ `ctx` along `direction[3]`, which was sampled with solid-angle `pdf`
+ (finite and > 0; the mixture's). A dropped record is
+ `GUIDING_STATUS_INVALID_ARGUMENT` and counted; `outcome` may be null.
+
+ # Safety
+ `field` a live handle; `ctx` readable; `direction` 3 floats; `outcome` null or writable.
+ */
+enum GuidingStatus guiding_field_record_radiance(const struct GuidingField *field,
+                                                 const struct GuidingShadingContext *ctx,
+                                                 const float *direction,
+                                                 float radiance,
+                                                 float pdf,
+                                                 enum GuidingRecordOutcome *outcome);
+
+/*
+ One direction sample for the learned BSDF fraction: the two
+ techniques' pdfs of the sampled direction and the sample's estimate
+ `|f cos| L / mixture_pdf`. `GUIDING_RECORD_OUTCOME_IGNORED` when the
+ configuration learns no fraction; a dropped record is
+ `GUIDING_STATUS_INVALID_ARGUMENT`.
+
+ # Safety
+ `field` a live handle; `ctx` readable; `outcome` null or writable.
+ */
+enum GuidingStatus guiding_field_record_fraction(const struct GuidingField *field,
+                                                 const struct GuidingShadingContext *ctx,
+                                                 float bsdf_pdf,
+                                                 float guiding_pdf,
+                                                 float contribution,
+                                                 enum GuidingRecordOutcome *outcome);
+
+/*
+ Ends an iteration: refines what was learned from the records and
+ splits cells. Waits for running queries on the handle, and they for it.
+ `outcome` may be null.
+
+ # Safety
+ `field` a live handle; `outcome` null or writable.
+ */
+enum GuidingStatus guiding_field_refine(const struct GuidingField *field,
+                                        struct GuidingRefineOutcome *outcome);
+
+/*
+ Forgets this iteration's records (a farm's worker, after loading the
+ coordinator's guide), keeping what was learned.
+
+ # Safety
+ `field` a live handle.
+ */
+enum GuidingStatus guiding_field_clear_records(const struct GuidingField *field);
+
+/*
+ Adds `other`'s records into `field` (a farm: both copies of one guide
+ after the same refinements); `GUIDING_STATUS_INCOMPATIBLE` otherwise,
+ with `field` unchanged.
+
+ # Safety
+ `field`, `other` live handles.
+ */
+enum GuidingStatus guiding_field_merge(const struct GuidingField *field,
+                                       const struct GuidingField *other);
+
+/*
+ What `field` learned, as bytes (`guiding_field_load` reads them back over the same light tree), into
+ `out` (free it with `guiding_buffer_free`).
+
+ # Safety
+ `field` a live handle; `out` writable.
+ */
+enum GuidingStatus guiding_field_save(const struct GuidingField *field,
+                                      struct GuidingBuffer *out);
 
 /*
  A GLT over `tree` for shading points in the box `lower[3]`..`upper[3]`
@@ -417,12 +815,42 @@ enum GuidingStatus guiding_glt_new(const struct GuidingLightTree *tree,
                                    struct GuidingGlt **out);
 
 /*
+ A GLT saved by `guiding_glt_save`, over `tree` (the light tree it was
+ saved over), from `len` bytes at `data`; `GUIDING_STATUS_LOAD_FAILED`
+ for bytes that are not one or another tree.
+
+ # Safety
+ `tree` a live handle; `data` `len` readable bytes; `out` writable.
+ */
+enum GuidingStatus guiding_glt_load(const struct GuidingLightTree *tree,
+                                    const uint8_t *data,
+                                    size_t len,
+                                    struct GuidingGlt **out);
+
+/*
  Frees `glt` (null is allowed and does nothing).
 
  # Safety
  `glt` null or a live handle, freed once, with no call on it running.
  */
 void guiding_glt_free(struct GuidingGlt *glt);
+
+/*
+ The refinements so far (0 for null).
+
+ # Safety
+ `glt` null or a live handle.
+ */
+uint32_t guiding_glt_iteration(const struct GuidingGlt *glt);
+
+/*
+ The records dropped as bad input so far, every reason together (0 for
+ null).
+
+ # Safety
+ `glt` null or a live handle.
+ */
+uint64_t guiding_glt_dropped_records(const struct GuidingGlt *glt);
 
 /*
  How many lights `glt` chooses among: its emitters, then its unbounded
@@ -446,8 +874,8 @@ enum GuidingStatus guiding_glt_sample(const struct GuidingGlt *glt,
                                       struct GuidingLightSample *out);
 
 /*
- The probability that `guiding_glt_sample` at `ctx` chooses `light`
- (for MIS with a BSDF sample that hit it), in `out`.
+ The probability that `guiding_glt_sample` at `ctx` chooses `light` (for
+ MIS with a BSDF sample that hit it), in `out`; exactly the sample's pmf.
 
  # Safety
  `glt` a live handle; `ctx` readable; `out` writable.
@@ -458,15 +886,13 @@ enum GuidingStatus guiding_glt_pmf(const struct GuidingGlt *glt,
                                    float *out);
 
 /*
- `guiding_glt_sample` for `count` shading points at once: `ctx[i]` with
- `u[i]` into `out[i]` (a wavefront renderer's batch; the guide's lock is
- taken once for the batch). Every input is checked before anything is
- written: on failure `out` is untouched and the message names the first
- bad element.
+ `guiding_glt_sample` for `count` points at once: `ctx[i]` with `u[i]` into
+ `out[i]` (a wavefront's batch; the guide's lock taken once). Every input
+ is checked before anything is written; the message names the first bad
+ element.
 
  # Safety
- `glt` a live handle; `ctx`, `u` `count` readable elements each; `out`
- `count` writable elements.
+ `glt` a live handle; `ctx`, `u` `count` readable elements; `out` `count` writable.
  */
 enum GuidingStatus guiding_glt_sample_batch(const struct GuidingGlt *glt,
                                             const struct GuidingShadingContext *ctx,
@@ -475,13 +901,11 @@ enum GuidingStatus guiding_glt_sample_batch(const struct GuidingGlt *glt,
                                             struct GuidingLightSample *out);
 
 /*
- `guiding_glt_pmf` for `count` shading points at once: the pmf of
- `light[i]` at `ctx[i]` into `out[i]` (the lock taken once). Every input
- is checked before anything is written.
+ `guiding_glt_pmf` for `count` points at once: the pmf of `light[i]` at
+ `ctx[i]` into `out[i]`. Every input is checked before anything is written.
 
  # Safety
- `glt` a live handle; `ctx`, `light` `count` readable elements each;
- `out` `count` writable floats.
+ `glt` a live handle; `ctx`, `light` `count` readable elements; `out` `count` writable floats.
  */
 enum GuidingStatus guiding_glt_pmf_batch(const struct GuidingGlt *glt,
                                          const struct GuidingShadingContext *ctx,
@@ -495,10 +919,9 @@ enum GuidingStatus guiding_glt_pmf_batch(const struct GuidingGlt *glt,
  BSDF and the cosine (from NEE `Le * T * w_mis / (pmf *
  pdf_solid_angle)`, 0 when occluded; from a BSDF sample that hit the
  emitter `Le * w_mis / pdf_direction`), one scalar such as luminance,
- finite and >= 0. What the
- record did goes to `outcome` (null allowed). A NaN, infinite or
- negative `value` is `GUIDING_STATUS_INVALID_ARGUMENT`, and the guide
- counts it among its dropped records.
+ finite and >= 0. What the record did goes to `outcome` (null allowed).
+ A NaN, infinite or negative `value` is `GUIDING_STATUS_INVALID_ARGUMENT`,
+ and the guide counts it among its dropped records.
 
  # Safety
  `glt` a live handle; `ctx` readable; `outcome` null or writable.
@@ -510,9 +933,9 @@ enum GuidingStatus guiding_glt_record_light(const struct GuidingGlt *glt,
                                             enum GuidingRecordOutcome *outcome);
 
 /*
- Ends an iteration: refines the cuts from their records and splits
- cells. Waits for running queries on `glt`, and they for it. `outcome`
- may be null.
+ Ends an iteration: refines what was learned from the records and
+ splits cells. Waits for running queries on the handle, and they for it.
+ `outcome` may be null.
 
  # Safety
  `glt` a live handle; `outcome` null or writable.
@@ -521,8 +944,8 @@ enum GuidingStatus guiding_glt_refine(const struct GuidingGlt *glt,
                                       struct GuidingRefineOutcome *outcome);
 
 /*
- Forgets this iteration's records (what a farm's worker does after
- loading the coordinator's guide), keeping what was learned.
+ Forgets this iteration's records (a farm's worker, after loading the
+ coordinator's guide), keeping what was learned.
 
  # Safety
  `glt` a live handle.
@@ -540,43 +963,13 @@ enum GuidingStatus guiding_glt_clear_records(const struct GuidingGlt *glt);
 enum GuidingStatus guiding_glt_merge(const struct GuidingGlt *glt, const struct GuidingGlt *other);
 
 /*
- The refinements so far (0 for null).
-
- # Safety
- `glt` null or a live handle.
- */
-uint32_t guiding_glt_iteration(const struct GuidingGlt *glt);
-
-/*
- The records dropped as bad input so far, every reason together (0 for
- null).
-
- # Safety
- `glt` null or a live handle.
- */
-uint64_t guiding_glt_dropped_records(const struct GuidingGlt *glt);
-
-/*
- What `glt` learned, as bytes (`guiding_glt_load` reads them back over
- the same light tree), into `out` (free it with `guiding_buffer_free`).
+ What `glt` learned, as bytes (`guiding_glt_load` reads them back over the same light tree), into
+ `out` (free it with `guiding_buffer_free`).
 
  # Safety
  `glt` a live handle; `out` writable.
  */
 enum GuidingStatus guiding_glt_save(const struct GuidingGlt *glt, struct GuidingBuffer *out);
-
-/*
- A GLT saved by `guiding_glt_save`, over `tree` (the light tree it was
- saved over), from `len` bytes at `data`; `GUIDING_STATUS_LOAD_FAILED`
- for bytes that are not one or another tree.
-
- # Safety
- `tree` a live handle; `data` `len` readable bytes; `out` writable.
- */
-enum GuidingStatus guiding_glt_load(const struct GuidingLightTree *tree,
-                                    const uint8_t *data,
-                                    size_t len,
-                                    struct GuidingGlt **out);
 
 /*
  Builds the light tree over `emitters` with `heuristic` (a
@@ -626,6 +1019,177 @@ enum GuidingStatus guiding_light_tree_save(const struct GuidingLightTree *tree,
 enum GuidingStatus guiding_light_tree_load(const uint8_t *data,
                                            size_t len,
                                            struct GuidingLightTree **out);
+
+/*
+ An SD-tree for shading points in the box `lower[3]`..`upper[3]`, with
+ `config` (null: the defaults), written to `out`.
+
+ # Safety
+ `lower`, `upper` 3 floats each; `config` null or readable; `out`
+ writable.
+ */
+enum GuidingStatus guiding_sd_tree_new(const float *lower,
+                                       const float *upper,
+                                       const struct GuidingSdTreeConfig *config,
+                                       struct GuidingSdTree **out);
+
+/*
+ An SD-tree saved by `guiding_sd_tree_save`, from `len` bytes at `data`;
+ `GUIDING_STATUS_LOAD_FAILED` for bytes that are not one.
+
+ # Safety
+ `data` `len` readable bytes; `out` writable.
+ */
+enum GuidingStatus guiding_sd_tree_load(const uint8_t *data,
+                                        size_t len,
+                                        struct GuidingSdTree **out);
+
+/*
+ Frees `sd_tree` (null is allowed and does nothing).
+
+ # Safety
+ `sd_tree` null or a live handle, freed once, with no call on it running.
+ */
+void guiding_sd_tree_free(struct GuidingSdTree *sd_tree);
+
+/*
+ The refinements so far (0 for null).
+
+ # Safety
+ `sd_tree` null or a live handle.
+ */
+uint32_t guiding_sd_tree_iteration(const struct GuidingSdTree *sd_tree);
+
+/*
+ The records dropped as bad input so far, every reason together (0 for
+ null).
+
+ # Safety
+ `sd_tree` null or a live handle.
+ */
+uint64_t guiding_sd_tree_dropped_records(const struct GuidingSdTree *sd_tree);
+
+/*
+ A direction from the guide's distribution at `ctx` with `u[2]` in
+ [0, 1): the unit direction and its solid-angle pdf in `out`.
+
+ # Safety
+ `sd_tree` a live handle; `ctx` readable; `u` 2 floats; `out` writable.
+ */
+enum GuidingStatus guiding_sd_tree_sample_direction(const struct GuidingSdTree *sd_tree,
+                                                    const struct GuidingShadingContext *ctx,
+                                                    const float *u,
+                                                    struct GuidingDirectionSample *out);
+
+/*
+ The guide's solid-angle pdf of `direction[3]` (any length but 0) at
+ `ctx`, in `out`.
+
+ # Safety
+ `sd_tree` a live handle; `ctx` readable; `direction` 3 floats; `out` writable.
+ */
+enum GuidingStatus guiding_sd_tree_direction_pdf(const struct GuidingSdTree *sd_tree,
+                                                 const struct GuidingShadingContext *ctx,
+                                                 const float *direction,
+                                                 float *out);
+
+/*
+ The probability of sampling the BSDF rather than the guide at `ctx`
+ (PPG's one-sample mixture), in `out`.
+
+ # Safety
+ `sd_tree` a live handle; `ctx` readable; `out` writable.
+ */
+enum GuidingStatus guiding_sd_tree_bsdf_fraction(const struct GuidingSdTree *sd_tree,
+                                                 const struct GuidingShadingContext *ctx,
+                                                 float *out);
+
+/*
+ The mixture's pdf of `direction[3]` at `ctx` given the BSDF's
+ `bsdf_pdf` of it: `a bsdf_pdf + (1 - a) guide_pdf`, in `out`.
+
+ # Safety
+ `sd_tree` a live handle; `ctx` readable; `direction` 3 floats; `out` writable.
+ */
+enum GuidingStatus guiding_sd_tree_mixture_pdf(const struct GuidingSdTree *sd_tree,
+                                               const struct GuidingShadingContext *ctx,
+                                               const float *direction,
+                                               float bsdf_pdf,
+                                               float *out);
+
+/*
+ PPG's record: `radiance` (one scalar, finite and >= 0) arrived at
+ `ctx` along `direction[3]`, which was sampled with solid-angle `pdf`
+ (finite and > 0; the mixture's). A dropped record is
+ `GUIDING_STATUS_INVALID_ARGUMENT` and counted; `outcome` may be null.
+
+ # Safety
+ `sd_tree` a live handle; `ctx` readable; `direction` 3 floats; `outcome` null or writable.
+ */
+enum GuidingStatus guiding_sd_tree_record_radiance(const struct GuidingSdTree *sd_tree,
+                                                   const struct GuidingShadingContext *ctx,
+                                                   const float *direction,
+                                                   float radiance,
+                                                   float pdf,
+                                                   enum GuidingRecordOutcome *outcome);
+
+/*
+ One direction sample for the learned BSDF fraction: the two
+ techniques' pdfs of the sampled direction and the sample's estimate
+ `|f cos| L / mixture_pdf`. `GUIDING_RECORD_OUTCOME_IGNORED` when the
+ configuration learns no fraction; a dropped record is
+ `GUIDING_STATUS_INVALID_ARGUMENT`.
+
+ # Safety
+ `sd_tree` a live handle; `ctx` readable; `outcome` null or writable.
+ */
+enum GuidingStatus guiding_sd_tree_record_fraction(const struct GuidingSdTree *sd_tree,
+                                                   const struct GuidingShadingContext *ctx,
+                                                   float bsdf_pdf,
+                                                   float guiding_pdf,
+                                                   float contribution,
+                                                   enum GuidingRecordOutcome *outcome);
+
+/*
+ Ends an iteration: refines what was learned from the records and
+ splits cells. Waits for running queries on the handle, and they for it.
+ `outcome` may be null.
+
+ # Safety
+ `sd_tree` a live handle; `outcome` null or writable.
+ */
+enum GuidingStatus guiding_sd_tree_refine(const struct GuidingSdTree *sd_tree,
+                                          struct GuidingRefineOutcome *outcome);
+
+/*
+ Forgets this iteration's records (a farm's worker, after loading the
+ coordinator's guide), keeping what was learned.
+
+ # Safety
+ `sd_tree` a live handle.
+ */
+enum GuidingStatus guiding_sd_tree_clear_records(const struct GuidingSdTree *sd_tree);
+
+/*
+ Adds `other`'s records into `sd_tree` (a farm: both copies of one guide
+ after the same refinements); `GUIDING_STATUS_INCOMPATIBLE` otherwise,
+ with `sd_tree` unchanged.
+
+ # Safety
+ `sd_tree`, `other` live handles.
+ */
+enum GuidingStatus guiding_sd_tree_merge(const struct GuidingSdTree *sd_tree,
+                                         const struct GuidingSdTree *other);
+
+/*
+ What `sd_tree` learned, as bytes (`guiding_sd_tree_load` reads them back), into
+ `out` (free it with `guiding_buffer_free`).
+
+ # Safety
+ `sd_tree` a live handle; `out` writable.
+ */
+enum GuidingStatus guiding_sd_tree_save(const struct GuidingSdTree *sd_tree,
+                                        struct GuidingBuffer *out);
 
 /*
  This thread's message for its last failed call (an empty string before

@@ -49,55 +49,27 @@ fn on_path(tool: &str) -> bool {
         .is_ok_and(|o| o.status.success())
 }
 
-#[test]
-fn the_c_program_trains_checks_saves_loads_and_merges() {
+/// Builds `source` (C99 or C++17, every warning an error) against the
+/// static library and runs it, under valgrind's memcheck when installed;
+/// returns what it printed.
+fn build_and_run(source: &str, cpp: bool) -> String {
     let lib = library_dir();
     assert!(
         lib.join("libguiding_c.a").exists(),
         "no libguiding_c.a in {}",
         lib.display()
     );
-    let exe = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("glt_test");
+    let name = Path::new(source).file_stem().expect("a file name");
+    let exe = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
     let dir = crate_dir();
-    run(Command::new("cc")
-        .args([
-            "-std=c99",
-            "-Wall",
-            "-Wextra",
-            "-Werror",
-            "-pedantic",
-            "-O1",
-            "-g",
-        ])
-        .arg(dir.join("tests/c/glt_test.c"))
-        .arg("-I")
-        .arg(dir.join("include"))
-        .arg(lib.join("libguiding_c.a"))
-        .args(["-lpthread", "-ldl", "-lm", "-o"])
-        .arg(&exe));
-    let out = if on_path("valgrind") {
-        run(Command::new("valgrind")
-            .args([
-                "--error-exitcode=3",
-                "--leak-check=full",
-                "--errors-for-leak-kinds=definite,indirect",
-                "--quiet",
-            ])
-            .arg(&exe))
+    let (compiler, std) = if cpp {
+        ("c++", "-std=c++17")
     } else {
-        run(&mut Command::new(&exe))
+        ("cc", "-std=c99")
     };
-    assert!(out.contains("every check passed"), "{out}");
-}
-
-#[test]
-fn the_cpp_wrapper_drives_a_renderers_nee_from_four_threads() {
-    let lib = library_dir();
-    let exe = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("nee_test");
-    let dir = crate_dir();
-    run(Command::new("c++")
+    run(Command::new(compiler)
         .args([
-            "-std=c++17",
+            std,
             "-Wall",
             "-Wextra",
             "-Werror",
@@ -106,13 +78,13 @@ fn the_cpp_wrapper_drives_a_renderers_nee_from_four_threads() {
             "-g",
             "-pthread",
         ])
-        .arg(dir.join("tests/cpp/nee_test.cpp"))
+        .arg(dir.join(source))
         .arg("-I")
         .arg(dir.join("include"))
         .arg(lib.join("libguiding_c.a"))
         .args(["-lpthread", "-ldl", "-lm", "-o"])
         .arg(&exe));
-    let out = if on_path("valgrind") {
+    if on_path("valgrind") {
         run(Command::new("valgrind")
             .args([
                 "--error-exitcode=3",
@@ -123,7 +95,24 @@ fn the_cpp_wrapper_drives_a_renderers_nee_from_four_threads() {
             .arg(&exe))
     } else {
         run(&mut Command::new(&exe))
-    };
+    }
+}
+
+#[test]
+fn the_c_program_trains_checks_saves_loads_and_merges() {
+    let out = build_and_run("tests/c/glt_test.c", false);
+    assert!(out.contains("every check passed"), "{out}");
+}
+
+#[test]
+fn the_sd_tree_and_the_field_from_c() {
+    let out = build_and_run("tests/c/directions_test.c", false);
+    assert!(out.contains("every check passed"), "{out}");
+}
+
+#[test]
+fn the_cpp_wrapper_drives_a_renderers_nee_from_four_threads() {
+    let out = build_and_run("tests/cpp/nee_test.cpp", true);
     assert!(out.contains("every check passed"), "{out}");
 }
 

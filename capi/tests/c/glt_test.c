@@ -147,7 +147,7 @@ int main(void) {
     OK(guiding_glt_config_default(&config));
     config.deterministic = true;
     GuidingGltConfig bad = config;
-    bad.sigma = -1.0;
+    bad.cut.sigma = -1.0;
     const float lo[3] = {0, 0, 0}, hi[3] = {10, 4, 10};
     GuidingGlt *refused = NULL;
     CHECK(guiding_glt_new(tree, lo, hi, &bad, &refused) == GUIDING_STATUS_INVALID_CONFIG, "sigma -1");
