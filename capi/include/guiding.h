@@ -122,6 +122,11 @@ typedef enum GuidingStatus {
    then on.
    */
   GUIDING_STATUS_PANIC = 7,
+  /*
+   The guide cannot be written as a GPU snapshot (the message says
+   why).
+   */
+  GUIDING_STATUS_SNAPSHOT_FAILED = 8,
 } GuidingStatus;
 
 /*
@@ -178,6 +183,11 @@ typedef struct GuidingLightTree GuidingLightTree;
  clear_records and merge wait for them.
  */
 typedef struct GuidingSdTree GuidingSdTree;
+
+/*
+ A snapshot (opaque): its arrays stay valid until `guiding_snapshot_free`.
+ */
+typedef struct GuidingSnapshot GuidingSnapshot;
 
 /*
  Bytes owned by the crate: `len` bytes at `data`. Free with
@@ -390,6 +400,72 @@ typedef struct GuidingRefineOutcome {
    */
   size_t refused_by_precision;
 } GuidingRefineOutcome;
+
+/*
+ One array of a snapshot: `bytes` bytes at `data` holding `count`
+ elements of the layout the crate's `snapshot::layout` documents
+ (little-endian `u32`, `f32` and `i16` fields, `#[repr(C)]`).
+ */
+typedef struct GuidingSnapshotArray {
+  /*
+   The first byte (null when `count` is 0).
+   */
+  const uint8_t *data;
+  /*
+   How many bytes.
+   */
+  size_t bytes;
+  /*
+   How many elements.
+   */
+  size_t count;
+} GuidingSnapshotArray;
+
+/*
+ Every array of a snapshot, in the order `gpu/`'s kernel binds them.
+ */
+typedef struct GuidingSnapshotArrays {
+  /*
+   The header: counts and shared rules (one element).
+   */
+  struct GuidingSnapshotArray header;
+  /*
+   The spatial tree's node words.
+   */
+  struct GuidingSnapshotArray spatial;
+  /*
+   One record per cell.
+   */
+  struct GuidingSnapshotArray cells;
+  /*
+   Every cell's cut nodes.
+   */
+  struct GuidingSnapshotArray cut_nodes;
+  /*
+   Each cell's learned fraction of every unbounded light.
+   */
+  struct GuidingSnapshotArray fractions;
+  /*
+   Each cell's learned visibilities (empty when none are learned).
+   */
+  struct GuidingSnapshotArray visibility;
+  /*
+   The light tree, as sibling pairs.
+   */
+  struct GuidingSnapshotArray tree;
+  /*
+   Per pair, where the right child's leaves start.
+   */
+  struct GuidingSnapshotArray first_right;
+  /*
+   Per pair, both nodes' bounds (empty when no rule reads importance).
+   */
+  struct GuidingSnapshotArray bounds;
+  /*
+   Per emitter, its leaf's position in depth-first leaf order.
+   */
+  struct GuidingSnapshotArray leaf_position;
+} GuidingSnapshotArrays;
 
 #ifdef __cplusplus
 extern "C" {
@@ -800,6 +876,17 @@ enum GuidingStatus guiding_field_save(const struct GuidingField *field,
                                       struct GuidingBuffer *out);
 
 /*
+ What `field` learned as a GPU snapshot's plain-data arrays (read them
+ with `guiding_snapshot_arrays`), written to `out`;
+ `GUIDING_STATUS_SNAPSHOT_FAILED` when it cannot be written as one.
+
+ # Safety
+ `field` a live handle; `out` writable.
+ */
+enum GuidingStatus guiding_field_snapshot(const struct GuidingField *field,
+                                          struct GuidingSnapshot **out);
+
+/*
  A GLT over `tree` for shading points in the box `lower[3]`..`upper[3]`
  (points outside are clamped onto it), with `config` (null: the
  defaults), written to `out`.
@@ -970,6 +1057,16 @@ enum GuidingStatus guiding_glt_merge(const struct GuidingGlt *glt, const struct 
  `glt` a live handle; `out` writable.
  */
 enum GuidingStatus guiding_glt_save(const struct GuidingGlt *glt, struct GuidingBuffer *out);
+
+/*
+ What `glt` learned as a GPU snapshot's plain-data arrays (read them
+ with `guiding_snapshot_arrays`), written to `out`;
+ `GUIDING_STATUS_SNAPSHOT_FAILED` when it cannot be written as one.
+
+ # Safety
+ `glt` a live handle; `out` writable.
+ */
+enum GuidingStatus guiding_glt_snapshot(const struct GuidingGlt *glt, struct GuidingSnapshot **out);
 
 /*
  Builds the light tree over `emitters` with `heuristic` (a
@@ -1190,6 +1287,33 @@ enum GuidingStatus guiding_sd_tree_merge(const struct GuidingSdTree *sd_tree,
  */
 enum GuidingStatus guiding_sd_tree_save(const struct GuidingSdTree *sd_tree,
                                         struct GuidingBuffer *out);
+
+/*
+ The arrays of `snapshot`, into `out` (pointers into the snapshot, valid
+ until it is freed).
+
+ # Safety
+ `snapshot` a live handle; `out` writable.
+ */
+enum GuidingStatus guiding_snapshot_arrays(const struct GuidingSnapshot *snapshot,
+                                           struct GuidingSnapshotArrays *out);
+
+/*
+ The bytes of all of `snapshot`'s arrays together (what a GPU holds; 0
+ for null).
+
+ # Safety
+ `snapshot` null or a live handle.
+ */
+size_t guiding_snapshot_bytes(const struct GuidingSnapshot *snapshot);
+
+/*
+ Frees `snapshot` (null is allowed and does nothing).
+
+ # Safety
+ `snapshot` null or a live handle, freed once.
+ */
+void guiding_snapshot_free(struct GuidingSnapshot *snapshot);
 
 /*
  This thread's message for its last failed call (an empty string before

@@ -61,6 +61,9 @@ using LightSample = GuidingLightSample;
 using GltConfig = GuidingGltConfig;
 using RecordOutcome = GuidingRecordOutcome;
 using RefineOutcome = GuidingRefineOutcome;
+using DirectionSample = GuidingDirectionSample;
+using SdTreeConfig = GuidingSdTreeConfig;
+using FieldConfig = GuidingFieldConfig;
 
 // A context at `position` on a surface with `normal` (zeros: none), lit by
 // every light.
@@ -78,6 +81,24 @@ inline GltConfig default_glt_config() {
     return c;
 }
 
+// The crate's default SD-tree configuration (PPG's), and Müller's improved one.
+inline SdTreeConfig default_sd_tree_config() {
+    SdTreeConfig c;
+    check(guiding_sd_tree_config_default(&c));
+    return c;
+}
+inline SdTreeConfig improved_sd_tree_config() {
+    SdTreeConfig c;
+    check(guiding_sd_tree_config_improved(&c));
+    return c;
+}
+// The crate's default field configuration.
+inline FieldConfig default_field_config() {
+    FieldConfig c;
+    check(guiding_field_config_default(&c));
+    return c;
+}
+
 namespace detail {
 struct FreeEmitters {
     void operator()(GuidingEmitters *p) const noexcept { guiding_emitters_free(p); }
@@ -87,6 +108,15 @@ struct FreeLightTree {
 };
 struct FreeGlt {
     void operator()(GuidingGlt *p) const noexcept { guiding_glt_free(p); }
+};
+struct FreeSdTree {
+    void operator()(GuidingSdTree *p) const noexcept { guiding_sd_tree_free(p); }
+};
+struct FreeField {
+    void operator()(GuidingField *p) const noexcept { guiding_field_free(p); }
+};
+struct FreeSnapshot {
+    void operator()(GuidingSnapshot *p) const noexcept { guiding_snapshot_free(p); }
 };
 // Bytes the crate handed out, copied into a vector and freed.
 inline std::vector<std::uint8_t> take(GuidingBuffer &b) {
@@ -237,6 +267,147 @@ private:
     explicit Glt(GuidingGlt *p) : handle_(p) {}
     std::unique_ptr<GuidingGlt, detail::FreeGlt> handle_;
 };
+
+// A GPU snapshot of what a GLT or a field learned: its plain arrays stay
+// valid while it lives.
+class Snapshot {
+public:
+    GuidingSnapshotArrays arrays() const {
+        GuidingSnapshotArrays a;
+        check(guiding_snapshot_arrays(handle_.get(), &a));
+        return a;
+    }
+    std::size_t bytes() const noexcept { return guiding_snapshot_bytes(handle_.get()); }
+    explicit Snapshot(GuidingSnapshot *p) : handle_(p) {}
+
+private:
+    std::unique_ptr<GuidingSnapshot, detail::FreeSnapshot> handle_;
+};
+
+inline Snapshot snapshot(const Glt &glt) {
+    GuidingSnapshot *p = nullptr;
+    check(guiding_glt_snapshot(glt.get(), &p));
+    return Snapshot(p);
+}
+
+// The directional calls, the same for the SD-tree and the field: `Self`
+// gives `get()`, `Ops` the C functions.
+#define GUIDING_DIRECTION_CALLS(prefix)                                                               \
+    DirectionSample sample_direction(const ShadingContext &ctx, float u0, float u1) const {           \
+        const float u[2] = {u0, u1};                                                                  \
+        DirectionSample s;                                                                            \
+        check(prefix##_sample_direction(get(), &ctx, u, &s));                                        \
+        return s;                                                                                     \
+    }                                                                                                 \
+    float direction_pdf(const ShadingContext &ctx, const Vec3 &direction) const {                     \
+        float p = 0;                                                                                  \
+        check(prefix##_direction_pdf(get(), &ctx, direction.data(), &p));                             \
+        return p;                                                                                     \
+    }                                                                                                 \
+    float bsdf_fraction(const ShadingContext &ctx) const {                                            \
+        float a = 0;                                                                                  \
+        check(prefix##_bsdf_fraction(get(), &ctx, &a));                                               \
+        return a;                                                                                     \
+    }                                                                                                 \
+    float mixture_pdf(const ShadingContext &ctx, const Vec3 &direction, float bsdf_pdf) const {       \
+        float p = 0;                                                                                  \
+        check(prefix##_mixture_pdf(get(), &ctx, direction.data(), bsdf_pdf, &p));                     \
+        return p;                                                                                     \
+    }                                                                                                 \
+    RecordOutcome record_radiance(const ShadingContext &ctx, const Vec3 &direction, float radiance,   \
+                                  float pdf) const {                                                  \
+        RecordOutcome o = GUIDING_RECORD_OUTCOME_RECORDED;                                            \
+        check(prefix##_record_radiance(get(), &ctx, direction.data(), radiance, pdf, &o));            \
+        return o;                                                                                     \
+    }                                                                                                 \
+    RecordOutcome record_fraction(const ShadingContext &ctx, float bsdf_pdf, float guiding_pdf,       \
+                                  float contribution) const {                                         \
+        RecordOutcome o = GUIDING_RECORD_OUTCOME_RECORDED;                                            \
+        check(prefix##_record_fraction(get(), &ctx, bsdf_pdf, guiding_pdf, contribution, &o));        \
+        return o;                                                                                     \
+    }                                                                                                 \
+    RefineOutcome refine() {                                                                          \
+        RefineOutcome r;                                                                              \
+        check(prefix##_refine(get(), &r));                                                            \
+        return r;                                                                                     \
+    }                                                                                                 \
+    void clear_records() { check(prefix##_clear_records(get())); }                                    \
+    std::vector<std::uint8_t> save() const {                                                          \
+        GuidingBuffer b;                                                                              \
+        check(prefix##_save(get(), &b));                                                              \
+        return detail::take(b);                                                                       \
+    }                                                                                                 \
+    std::uint32_t iteration() const noexcept { return prefix##_iteration(get()); }                    \
+    std::uint64_t dropped_records() const noexcept { return prefix##_dropped_records(get()); }
+
+// Practical Path Guiding's SD-tree: learned directions per region.
+class SdTree {
+public:
+    SdTree(const Vec3 &lower, const Vec3 &upper, const SdTreeConfig &config = default_sd_tree_config()) {
+        GuidingSdTree *p = nullptr;
+        check(guiding_sd_tree_new(lower.data(), upper.data(), &config, &p));
+        handle_.reset(p);
+    }
+    static SdTree load(span<const std::uint8_t> bytes) {
+        GuidingSdTree *p = nullptr;
+        check(guiding_sd_tree_load(bytes.data(), bytes.size(), &p));
+        return SdTree(p);
+    }
+    void merge(const SdTree &other) { check(guiding_sd_tree_merge(get(), other.get())); }
+    GUIDING_DIRECTION_CALLS(guiding_sd_tree)
+    GuidingSdTree *get() const noexcept { return handle_.get(); }
+
+private:
+    explicit SdTree(GuidingSdTree *p) : handle_(p) {}
+    std::unique_ptr<GuidingSdTree, detail::FreeSdTree> handle_;
+};
+
+// The SD-tree and the GLT in one spatial tree: the light choice and the
+// directions from one lookup.
+class Field {
+public:
+    Field(const LightTree &tree, const Vec3 &lower, const Vec3 &upper,
+          const FieldConfig &config = default_field_config()) {
+        GuidingField *p = nullptr;
+        check(guiding_field_new(tree.get(), lower.data(), upper.data(), &config, &p));
+        handle_.reset(p);
+    }
+    static Field load(const LightTree &tree, span<const std::uint8_t> bytes) {
+        GuidingField *p = nullptr;
+        check(guiding_field_load(tree.get(), bytes.data(), bytes.size(), &p));
+        return Field(p);
+    }
+    LightSample sample(const ShadingContext &ctx, float u) const {
+        LightSample s;
+        check(guiding_field_sample(get(), &ctx, u, &s));
+        return s;
+    }
+    float pmf(const ShadingContext &ctx, std::uint32_t light) const {
+        float p = 0;
+        check(guiding_field_pmf(get(), &ctx, light, &p));
+        return p;
+    }
+    RecordOutcome record_light(const ShadingContext &ctx, std::uint32_t light, float value) const {
+        RecordOutcome o = GUIDING_RECORD_OUTCOME_RECORDED;
+        check(guiding_field_record_light(get(), &ctx, light, value, &o));
+        return o;
+    }
+    void merge(const Field &other) { check(guiding_field_merge(get(), other.get())); }
+    Snapshot snapshot() const {
+        GuidingSnapshot *p = nullptr;
+        check(guiding_field_snapshot(get(), &p));
+        return Snapshot(p);
+    }
+    std::uint32_t light_count() const noexcept { return guiding_field_light_count(get()); }
+    GUIDING_DIRECTION_CALLS(guiding_field)
+    GuidingField *get() const noexcept { return handle_.get(); }
+
+private:
+    explicit Field(GuidingField *p) : handle_(p) {}
+    std::unique_ptr<GuidingField, detail::FreeField> handle_;
+};
+
+#undef GUIDING_DIRECTION_CALLS
 
 }  // namespace guiding
 

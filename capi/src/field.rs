@@ -444,3 +444,21 @@ pub unsafe extern "C" fn guiding_field_save(
         unsafe { get(field, "field") }?.0.save(out)
     })
 }
+/// What `field` learned as a GPU snapshot's plain-data arrays (read them
+/// with `guiding_snapshot_arrays`), written to `out`;
+/// `GUIDING_STATUS_SNAPSHOT_FAILED` when it cannot be written as one.
+///
+/// # Safety
+/// `field` a live handle; `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn guiding_field_snapshot(
+    field: *const GuidingField,
+    out: *mut *mut crate::snapshot::GuidingSnapshot,
+) -> GuidingStatus {
+    guard(|| {
+        // SAFETY: forwarded.
+        let g = unsafe { get(field, "field") }?;
+        let snapshot = g.0.read()?.snapshot();
+        crate::snapshot::hand_out(snapshot, out)
+    })
+}

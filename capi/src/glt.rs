@@ -315,3 +315,21 @@ pub unsafe extern "C" fn guiding_glt_save(
         unsafe { get(glt, "glt") }?.0.save(out)
     })
 }
+/// What `glt` learned as a GPU snapshot's plain-data arrays (read them
+/// with `guiding_snapshot_arrays`), written to `out`;
+/// `GUIDING_STATUS_SNAPSHOT_FAILED` when it cannot be written as one.
+///
+/// # Safety
+/// `glt` a live handle; `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn guiding_glt_snapshot(
+    glt: *const GuidingGlt,
+    out: *mut *mut crate::snapshot::GuidingSnapshot,
+) -> GuidingStatus {
+    guard(|| {
+        // SAFETY: forwarded.
+        let g = unsafe { get(glt, "glt") }?;
+        let snapshot = g.0.read()?.snapshot();
+        crate::snapshot::hand_out(snapshot, out)
+    })
+}

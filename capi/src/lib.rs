@@ -34,6 +34,7 @@ mod handle;
 mod light_calls;
 mod light_tree;
 mod sd_tree;
+mod snapshot;
 mod status;
 
 pub use buffer::*;
@@ -45,4 +46,5 @@ pub use field::*;
 pub use glt::*;
 pub use light_tree::*;
 pub use sd_tree::*;
+pub use snapshot::*;
 pub use status::*;

@@ -34,6 +34,9 @@ pub enum GuidingStatus {
     /// report it). A guide that panicked while refining answers this from
     /// then on.
     Panic = 7,
+    /// The guide cannot be written as a GPU snapshot (the message says
+    /// why).
+    SnapshotFailed = 8,
 }
 
 /// A failure: its status and message.

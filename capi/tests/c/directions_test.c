@@ -223,6 +223,12 @@ int main(void) {
         OK(guiding_field_direction_pdf(field, &fctx, ds.direction, &dp));
         CHECK(dp == ds.pdf, "field direction pdf %g against %g", dp, ds.pdf);
     }
+    GuidingSnapshot *snap = NULL;
+    OK(guiding_field_snapshot(field, &snap));
+    GuidingSnapshotArrays arrays;
+    OK(guiding_snapshot_arrays(snap, &arrays));
+    CHECK(arrays.leaf_position.count == 50 && arrays.cells.count > 0, "field snapshot");
+    guiding_snapshot_free(snap);
     GuidingBuffer fb;
     OK(guiding_field_save(field, &fb));
     GuidingField *field2 = NULL;

@@ -258,6 +258,24 @@ int main(void) {
     OK(guiding_glt_record_light(glt, &ctx, 0, 0.0f, &outcome));
     CHECK(outcome == GUIDING_RECORD_OUTCOME_ZERO, "outcome %d", (int)outcome);
 
+    /* The GPU snapshot: plain arrays, one per buffer, their sizes adding
+       up; one leaf position per emitter. */
+    {
+        GuidingSnapshot *snap = NULL;
+        OK(guiding_glt_snapshot(glt, &snap));
+        GuidingSnapshotArrays a;
+        OK(guiding_snapshot_arrays(snap, &a));
+        size_t total = a.header.bytes + a.spatial.bytes + a.cells.bytes + a.cut_nodes.bytes + a.fractions.bytes +
+                       a.visibility.bytes + a.tree.bytes + a.first_right.bytes + a.bounds.bytes + a.leaf_position.bytes;
+        CHECK(total == guiding_snapshot_bytes(snap) && total > 0, "%zu bytes against %zu", total, guiding_snapshot_bytes(snap));
+        CHECK(a.header.count == 1 && a.cells.count > 1 && a.spatial.count >= a.cells.count, "cells %zu, nodes %zu", a.cells.count, a.spatial.count);
+        CHECK(a.leaf_position.count == LIGHTS && a.leaf_position.bytes == 4 * LIGHTS, "leaf positions %zu", a.leaf_position.count);
+        CHECK(a.cells.data != NULL && a.header.data != NULL, "null arrays");
+        guiding_snapshot_free(snap);
+        CHECK(guiding_glt_snapshot(glt, NULL) == GUIDING_STATUS_NULL_POINTER, "null out");
+        guiding_snapshot_free(NULL);
+    }
+
     /* Save and load: the same choices, bit for bit. */
     GuidingBuffer saved;
     OK(guiding_glt_save(glt, &saved));

@@ -239,6 +239,35 @@ int main() {
     all.refine();
     CHECK(a.save() == all.save(), "the merged farm differs from one guide");
 
+    // The field and the SD-tree through their classes: one lookup's light
+    // and direction, each sample equal to its pmf or pdf.
+    {
+        guiding::Field field(tree, {0, 0, 0}, {20, 4, 10});
+        Rng rng{9};
+        for (int pass = 0; pass < 2; pass++) {
+            for (int k = 0; k < 3000; k++) {
+                guiding::ShadingContext ctx = floor_point(20 * rng.next(), 10 * rng.next());
+                guiding::LightSample s = field.sample(ctx, rng.next());
+                field.record_light(ctx, s.light, 1.0f / s.pmf);
+                guiding::DirectionSample d = field.sample_direction(ctx, rng.next(), rng.next());
+                field.record_radiance(ctx, {d.direction[0], d.direction[1], d.direction[2]}, d.direction[1] > 0 ? 1.0f : 0.0f, d.pdf);
+            }
+            field.refine();
+        }
+        guiding::ShadingContext ctx = floor_point(3, 3);
+        guiding::LightSample s = field.sample(ctx, 0.4f);
+        CHECK(field.pmf(ctx, s.light) == s.pmf, "field pmf");
+        guiding::DirectionSample d = field.sample_direction(ctx, 0.3f, 0.6f);
+        CHECK(field.direction_pdf(ctx, {d.direction[0], d.direction[1], d.direction[2]}) == d.pdf, "field pdf");
+        CHECK(field.snapshot().bytes() > 0, "field snapshot");
+        guiding::Field copy = guiding::Field::load(tree, field.save());
+        CHECK(copy.sample(ctx, 0.4f).light == s.light, "loaded field");
+        guiding::SdTree sd({0, 0, 0}, {20, 4, 10}, guiding::improved_sd_tree_config());
+        guiding::DirectionSample e = sd.sample_direction(ctx, 0.5f, 0.5f);
+        CHECK(sd.direction_pdf(ctx, {e.direction[0], e.direction[1], e.direction[2]}) == e.pdf, "sd pdf");
+        CHECK(guiding::snapshot(glt).bytes() > 0, "glt snapshot");
+    }
+
     if (failures) {
         std::fprintf(stderr, "%d checks failed\n", failures);
         return 1;
