@@ -29,13 +29,6 @@ fn hand_out(guide: FieldGuide<Arc<LightTree>>, out: *mut *mut GuidingField) -> R
     })
 }
 
-fn built(e: guiding::Error) -> Failure {
-    match e {
-        guiding::Error::Config(c) => Failure::new(GuidingStatus::InvalidConfig, c.to_string()),
-        e => Failure::new(GuidingStatus::BuildFailed, e.to_string()),
-    }
-}
-
 /// A field over `tree` for shading points in the box `lower[3]`..`upper[3]`,
 /// with `config` (null: the defaults), written to `out`.
 ///
@@ -68,7 +61,8 @@ pub unsafe extern "C" fn guiding_field_new(
             return Err(Failure::null("out"));
         }
         hand_out(
-            FieldGuide::new(Arc::clone(&t.tree), Aabb::new(lo, hi), config).map_err(built)?,
+            FieldGuide::new(Arc::clone(&t.tree), Aabb::new(lo, hi), config)
+                .map_err(Failure::built)?,
             out,
         )
     })

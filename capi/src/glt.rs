@@ -36,13 +36,6 @@ fn hand_out(guide: GltGuide<Arc<LightTree>>, out: *mut *mut GuidingGlt) -> Resul
     })
 }
 
-fn built(e: guiding::Error) -> Failure {
-    match e {
-        guiding::Error::Config(c) => Failure::new(GuidingStatus::InvalidConfig, c.to_string()),
-        e => Failure::new(GuidingStatus::BuildFailed, e.to_string()),
-    }
-}
-
 /// A GLT over `tree` for shading points in the box `lower[3]`..`upper[3]`
 /// (points outside are clamped onto it), with `config` (null: the
 /// defaults), written to `out`.
@@ -76,7 +69,8 @@ pub unsafe extern "C" fn guiding_glt_new(
             return Err(Failure::null("out"));
         }
         hand_out(
-            guiding::Glt::new(Arc::clone(&t.tree), Aabb::new(lo, hi), config).map_err(built)?,
+            guiding::Glt::new(Arc::clone(&t.tree), Aabb::new(lo, hi), config)
+                .map_err(Failure::built)?,
             out,
         )
     })

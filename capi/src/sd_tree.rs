@@ -25,13 +25,6 @@ fn hand_out(guide: SdTree, out: *mut *mut GuidingSdTree) -> Result<(), Failure> 
     })
 }
 
-fn built(e: guiding::Error) -> Failure {
-    match e {
-        guiding::Error::Config(c) => Failure::new(GuidingStatus::InvalidConfig, c.to_string()),
-        e => Failure::new(GuidingStatus::BuildFailed, e.to_string()),
-    }
-}
-
 /// An SD-tree for shading points in the box `lower[3]`..`upper[3]`, with
 /// `config` (null: the defaults), written to `out`.
 ///
@@ -56,7 +49,10 @@ pub unsafe extern "C" fn guiding_sd_tree_new(
         if out.is_null() {
             return Err(Failure::null("out"));
         }
-        hand_out(SdTree::new(Aabb::new(lo, hi), config).map_err(built)?, out)
+        hand_out(
+            SdTree::new(Aabb::new(lo, hi), config).map_err(Failure::built)?,
+            out,
+        )
     })
 }
 

@@ -58,6 +58,13 @@ impl Failure {
     pub fn null(name: &str) -> Self {
         Self::new(GuidingStatus::NullPointer, format!("{name} is null"))
     }
+    /// A guide's constructor's error: its configuration's, or its build's.
+    pub fn built(e: guiding::Error) -> Self {
+        match e {
+            guiding::Error::Config(c) => Self::new(GuidingStatus::InvalidConfig, c.to_string()),
+            e => Self::new(GuidingStatus::BuildFailed, e.to_string()),
+        }
+    }
 }
 
 thread_local! {
