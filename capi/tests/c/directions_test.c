@@ -10,19 +10,7 @@
 #include <stdio.h>
 #include <string.h>
 
-static int failures = 0;
-
-#define CHECK(cond, ...)                                                   \
-    do {                                                                   \
-        if (!(cond)) {                                                     \
-            fprintf(stderr, "%s:%d: %s: ", __FILE__, __LINE__, #cond);     \
-            fprintf(stderr, __VA_ARGS__);                                  \
-            fprintf(stderr, " (last error: %s)\n", guiding_last_error());  \
-            failures++;                                                    \
-        }                                                                  \
-    } while (0)
-
-#define OK(call) CHECK((call) == GUIDING_STATUS_OK, "%s", "not OK")
+#include "check.h"
 
 static uint64_t rng_state = 1;
 static float next_float(void) {

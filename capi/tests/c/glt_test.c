@@ -11,19 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int failures = 0;
-
-#define CHECK(cond, ...)                                          \
-    do {                                                          \
-        if (!(cond)) {                                            \
-            fprintf(stderr, "%s:%d: %s: ", __FILE__, __LINE__, #cond); \
-            fprintf(stderr, __VA_ARGS__);                         \
-            fprintf(stderr, " (last error: %s)\n", guiding_last_error()); \
-            failures++;                                           \
-        }                                                         \
-    } while (0)
-
-#define OK(call) CHECK((call) == GUIDING_STATUS_OK, "%s", "not OK")
+#include "check.h"
 
 /* A small deterministic generator (the test's, not the crate's). */
 static uint64_t rng_state = 0x853c49e6748fea9bULL;
