@@ -21,4 +21,4 @@
 //! assert!(config.validate().is_ok());
 //! ```
 
-pub use crate::cut::{BelowCut, Modulation, Prior, SplitPrior};
+pub use crate::cut::{BelowCut, ImportanceBound, Modulation, Prior, SplitPrior};

@@ -25,7 +25,7 @@ use common::{ByPosition, LightsAt};
 
 use common::{Rand, scene, two_rooms, value};
 use glam::Vec3;
-use guiding::cut::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
+use guiding::cut::{BelowCut, CutConfig, ImportanceBound, Modulation, Prior, SplitPrior};
 use guiding::field::{FieldConfig, GuidingField};
 use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::ImportanceTreeSampler;
@@ -62,6 +62,7 @@ fn glt_configured() -> GltConfig {
             modulation: Modulation::None,
             prior: Prior::Power,
             split_prior: SplitPrior::Power,
+            importance_bound: ImportanceBound::Grandchildren,
             unbounded: UnboundedLights::new(2, 0.25).unwrap(),
             accumulation: Accumulation::Deterministic,
             min_records: 10,
@@ -278,8 +279,12 @@ fn load_and_answer(
     tree: &LightTree,
     version: u32,
 ) -> Result<(String, Vec<u8>), LoadError> {
+    // What an older version could not hold loads as its rule then was.
     let learned = |mut cut: CutConfig| {
         cut.visibility &= version >= 2;
+        if version < 6 {
+            cut.importance_bound = ImportanceBound::Children;
+        }
         cut
     };
     let mut out = String::new();

@@ -7,7 +7,8 @@
 use glam::Vec3;
 use guiding::LightChoice;
 use guiding::cut::{
-    BelowCut, CutConfig, CutNode, CutRules, GuidingCut, Modulation, Prior, Slot, SplitPrior,
+    BelowCut, CutConfig, CutNode, CutRules, GuidingCut, ImportanceBound, Modulation, Prior, Slot,
+    SplitPrior,
 };
 use guiding::light_tree::{BuildHeuristic, EmitterPath, NodeBounds};
 use guiding::math::{Aabb, Accumulation, Side};
@@ -242,9 +243,10 @@ fn config_strategy() -> impl Strategy<Value = CutConfig> {
         prop_oneof![Just(0u32), Just(1), Just(64)],
         any::<bool>(),
         any::<bool>(),
+        any::<bool>(),
     )
         .prop_map(
-            |(sigma, alpha, variant, unbounded, exact, min_records, modulate, prior_imp)| {
+            |(sigma, alpha, variant, unbounded, exact, min_records, modulate, prior_imp, own)| {
                 let (below_cut, split_prior) = ALL_CONFIGS[variant];
                 CutConfig {
                     sigma,
@@ -256,6 +258,11 @@ fn config_strategy() -> impl Strategy<Value = CutConfig> {
                         Modulation::None
                     },
                     split_prior,
+                    importance_bound: if own {
+                        ImportanceBound::Children
+                    } else {
+                        ImportanceBound::Grandchildren
+                    },
                     unbounded,
                     accumulation: if exact {
                         Accumulation::Deterministic
@@ -1266,6 +1273,9 @@ fn modulation_reproduces_the_learned_cut_at_the_anchor_and_follows_importance() 
 /// is the `ImportanceTreeSampler`'s pmf. With `BelowCut::Power` it is not
 /// (the control). Importance is evaluated whatever the prior rule (a
 /// mutant that evaluated it only for an importance prior went unseen).
+/// The light BVH weighs each child by its own bound, so the cut does too
+/// here (`ImportanceBound::Children`; the default's grandchildren are
+/// `child_weights_follow_the_grandchildren`'s).
 #[test]
 fn below_cut_importance_is_the_importance_walk() {
     let mut rng = Rand::new(41);
@@ -1296,6 +1306,7 @@ fn below_cut_importance_is_the_importance_walk() {
                 below_cut,
                 modulation: Modulation::None,
                 prior,
+                importance_bound: ImportanceBound::Children,
                 ..CutConfig::default()
             };
             let guide = CutRules::new(&tree, config).unwrap();

@@ -504,7 +504,7 @@ fn broken_arrays_are_named() {
         SnapshotView::new(o.arrays().unwrap()).err()
     };
     assert_eq!(broken(0, &|h| h[0] ^= 1), Some(SnapshotError::Magic));
-    assert_eq!(broken(0, &|h| h[1] = 2), Some(SnapshotError::Version(2)));
+    assert_eq!(broken(0, &|h| h[1] = 3), Some(SnapshotError::Version(3)));
     assert_eq!(
         broken(1, &|s| s[0] = 0),
         Some(SnapshotError::Invalid("spatial"))

@@ -1,8 +1,9 @@
 // The GLT's light choice over a guiding snapshot, one invocation per query.
 //
-// This is guiding's `src/snapshot/sampling.rs` and
-// `src/snapshot/importance.rs` line for line (read those for the why of
-// each step); the snapshot's arrays sit end to end in one word buffer
+// This is guiding's `src/snapshot/sampling.rs` line for line, and the
+// importance lanes of `src/cut/child_weights.rs` (gathered as
+// `src/snapshot/importance.rs` gathers them) one lane at a time (read
+// those for the why of each step); the snapshot's arrays sit end to end in one word buffer
 // (`snap`), at the word offsets its first sixteen words give
 // (`gpu/src/pack.rs`). Non-finite values are tested on their bits: WGSL
 // lets a compiler assume floats are finite, and the snapshot stores NaN
@@ -47,6 +48,7 @@ const NO_EMITTER: u32 = 0xffffffffu;
 const NOTHING: u32 = 0xffffffffu;
 const BELOW_IMPORTANCE: u32 = 1u;
 const PRIOR_IMPORTANCE: u32 = 2u;
+const GRANDCHILDREN: u32 = 4u;
 const MODULATED: u32 = 1u;
 const PRIOR: u32 = 2u;
 const OMNI: u32 = 1u;
@@ -78,7 +80,7 @@ fn is_nan(x: f32) -> bool {
 }
 
 // ---------------------------------------------------------------------------
-// Importance (src/snapshot/importance.rs)
+// Importance, one lane of src/cut/child_weights.rs at a time
 // ---------------------------------------------------------------------------
 
 fn from_bf16(b: u32) -> f32 {
@@ -172,18 +174,56 @@ fn importance(q: Point, at: u32) -> vec2<f32> {
     return vec2<f32>(a, dist2);
 }
 
-// The weights of pair `k`'s two nodes, in the ratio of their importances.
-fn pair_weights(q: Point, k: u32) -> vec2<f32> {
-    let l = importance(q, k * 16u);
-    let r = importance(q, k * 16u + 8u);
-    let m = max(l.y, r.y);
-    var dl = 1.0;
-    var dr = 1.0;
-    if m > 0.0 {
-        dl = l.y / m;
-        dr = r.y / m;
+// Four lanes' numerators `a` and squared distances `d` brought to one
+// scale: the smallest squared distance among the lanes that contribute.
+fn scaled(a: vec4<f32>, d: vec4<f32>) -> vec4<f32> {
+    var m = 3.40282347e+38;
+    for (var i = 0u; i < 4u; i++) {
+        if a[i] > 0.0 {
+            m = min(m, d[i]);
+        }
     }
-    return vec2<f32>(l.x * dr, r.x * dl);
+    var w = vec4<f32>(0.0);
+    for (var i = 0u; i < 4u; i++) {
+        if d[i] <= m {
+            w[i] = a[i];
+        } else {
+            w[i] = a[i] * (m / d[i]);
+        }
+    }
+    return w;
+}
+
+// The weights of the two children of the node whose children are pair
+// `k`, that node at depth `depth` (src/cut/child_weights.rs): at even
+// depth each child by its two children's importances (a leaf child by
+// its own), at odd depth by its own.
+fn child_weights(q: Point, k: u32, depth: u32) -> vec2<f32> {
+    if (depth & 1u) == 1u {
+        let l = importance(q, k * 16u);
+        let r = importance(q, k * 16u + 8u);
+        let w = scaled(vec4<f32>(l.x, r.x, 0.0, 0.0), vec4<f32>(l.y, r.y, 1.0, 1.0));
+        return vec2<f32>(w.x, w.y);
+    }
+    var a = vec4<f32>(0.0);
+    var d = vec4<f32>(1.0);
+    for (var s = 0u; s < 2u; s++) {
+        let link = word(TREE, k * 4u + 2u * s + 1u);
+        var x = vec2<f32>(0.0, 1.0);
+        var y = vec2<f32>(0.0, 1.0);
+        if (link & LEAF) == 0u {
+            x = importance(q, link * 16u);
+            y = importance(q, link * 16u + 8u);
+        } else {
+            x = importance(q, k * 16u + 8u * s);
+        }
+        a[2u * s] = x.x;
+        d[2u * s] = x.y;
+        a[2u * s + 1u] = y.x;
+        d[2u * s + 1u] = y.y;
+    }
+    let w = scaled(a, d);
+    return vec2<f32>(w.x + w.y, w.z + w.w);
 }
 
 // ---------------------------------------------------------------------------
@@ -222,6 +262,7 @@ struct Rule {
     cell: u32,
     below_importance: bool,
     prior_importance: bool,
+    grandchildren: bool,
     modulate: bool,
     prior: bool,
 }
@@ -282,6 +323,7 @@ fn rule(query: Query) -> Rule {
     let cell_flags = cell_word(r, 3u);
     r.below_importance = (flags & BELOW_IMPORTANCE) != 0u;
     r.prior_importance = (flags & PRIOR_IMPORTANCE) != 0u;
+    r.grandchildren = (flags & GRANDCHILDREN) != 0u;
     r.modulate = (cell_flags & MODULATED) != 0u;
     r.prior = (cell_flags & PRIOR) != 0u;
     return r;
@@ -297,7 +339,7 @@ struct Step {
 
 // The step at the inner entry with split `split` and children pair `k`,
 // inside the cut at cut node `cut` (NOTHING: below the cut).
-fn step(r: Rule, split: f32, k: u32, cut: u32) -> Step {
+fn step(r: Rule, split: f32, k: u32, cut: u32, depth: u32) -> Step {
     let power = decode_split(split);
     var needs_importance = r.prior_importance;
     if cut != NOTHING {
@@ -309,7 +351,9 @@ fn step(r: Rule, split: f32, k: u32, cut: u32) -> Step {
     var imp = vec2<f32>(0.0);
     // The bounds array is empty when no rule reads importance.
     if needs_importance && snap[BOUNDS] != snap[LEAF_POSITION] {
-        imp = pair_weights(r.q, k);
+        // Without the grandchildren's bound every level weighs as an odd
+        // one does.
+        imp = child_weights(r.q, k, select(1u, depth, r.grandchildren));
         has_imp = true;
     }
     var by_importance = power;
@@ -487,9 +531,11 @@ fn sample(query: Query) -> Answer {
     var cut = select(NOTHING, 0u, nodes > 0u);
     var p = vec2<f32>(1.0, 1.0);
     var slot = 0u;
+    var depth = 0u;
     while (link & LEAF) == 0u {
         let k = link;
-        let s = step(r, split, k, cut);
+        let s = step(r, split, k, cut, depth);
+        depth += 1u;
         var pair = s.prior;
         if use_cut {
             pair = s.cut;
@@ -539,9 +585,11 @@ fn pmf(query: Query) -> f32 {
     var link = word(TREE, 1u);
     var cut = select(NOTHING, 0u, cell_word(r, 1u) > 0u);
     var p = vec2<f32>(1.0, 1.0);
+    var depth = 0u;
     while (link & LEAF) == 0u {
         let k = link;
-        let s = step(r, split, k, cut);
+        let s = step(r, split, k, cut, depth);
+        depth += 1u;
         let side = select(0u, 1u, position >= word(FIRST_RIGHT, k));
         p = apply(r, p, s, side);
         if cut != NOTHING {

@@ -6,13 +6,18 @@
 mod common;
 
 use common::{compare, context, glt_answers};
+use guiding::config::ImportanceBound;
 use guiding::{Glt, LightChoice, LightTree};
 use guiding_gpu::{Answer, Gpu, GpuSampler, Query};
+use guiding_render::methods::GuideParams;
 
 /// For each query where the snapshot chose another light than the GLT,
 /// the distance from its number to a number from which the GLT chooses
 /// the snapshot's light (searched in steps finer than that light's pmf,
-/// up to 1e-5; `None` beyond).
+/// up to 1e-5, then in steps of 1e-11 up to 1e-7: the light's interval
+/// near the number can be far narrower than its pmf, which sums the
+/// cut's and the prior's components, each an interval of its own;
+/// `None` beyond).
 fn boundary_distances(
     glt: &Glt<&LightTree>,
     queries: &[Query],
@@ -31,12 +36,15 @@ fn boundary_distances(
                 .is_some_and(|(l, _)| Query::light_word(l) == s.light)
         };
         let step = (f64::from(s.pmf) / 2.0).clamp(1e-10, 1e-8);
-        out.push(
-            (1..)
-                .map(|k| k as f64 * step)
-                .take_while(|&t| t <= 1e-5)
-                .find(|&t| chooses(-t) || chooses(t)),
-        );
+        let coarse = (1..)
+            .map(|k| k as f64 * step)
+            .take_while(|&t| t <= 1e-5)
+            .find(|&t| chooses(-t) || chooses(t));
+        out.push(coarse.or_else(|| {
+            (1..=10_000)
+                .map(|k| k as f64 * 1e-11)
+                .find(|&t| chooses(-t) || chooses(t))
+        }));
     }
     out
 }
@@ -51,8 +59,23 @@ fn boundary_distances(
 /// boundary (seen: all within 3e-7), pmfs within 1e-5 (seen: 1.0e-6).
 #[test]
 fn the_gpu_chooses_as_the_cpu_on_a_trained_city() {
+    chooses_as_the_cpu(ImportanceBound::Children);
+}
+
+/// The same with each child weighed by its children (snapshot flag
+/// `GRANDCHILDREN`).
+#[test]
+fn the_gpu_chooses_as_the_cpu_weighing_by_grandchildren() {
+    chooses_as_the_cpu(ImportanceBound::Grandchildren);
+}
+
+fn chooses_as_the_cpu(bound: ImportanceBound) {
     let scene = common::city();
-    let glt = common::trained(&scene, (64, 48), 16);
+    let params = GuideParams {
+        importance_bound: bound,
+        ..GuideParams::default()
+    };
+    let glt = common::trained_with(&scene, (64, 48), 16, params);
     let snapshot = glt.snapshot().expect("a snapshot");
     let queries = common::queries(&scene, 50_000, 20);
     assert!(queries.len() >= 1_000_000);

@@ -1,6 +1,7 @@
 //! [`CutRules`]: what every cell's cut shares: the light tree, the tables
 //! the GLT's walk reads, and the cut configuration.
 
+use super::child_weights::Lanes;
 use super::config::CutConfig;
 use super::guiding_cut::GuidingCut;
 use super::importance_table::FastQuery;
@@ -46,7 +47,7 @@ impl<H: LightHierarchy> CutRules<H> {
 
     /// [`CutRules::new`] for a `config` known to be valid.
     fn with_valid_config(tree: H, config: CutConfig) -> Self {
-        let importance = config.uses_importance();
+        let importance = config.uses_importance().then_some(config.importance_bound);
         let (tables, instanced) = match tree.as_instanced() {
             Some(inst) => (
                 TreeTables::new(inst.top(), importance),
@@ -130,6 +131,23 @@ impl<H: LightHierarchy> CutRules<H> {
     pub(crate) fn instanced(&self) -> Option<(&InstancedTables, &InstancedLightTree)> {
         let tree = self.tree.as_instanced()?;
         Some((self.instanced.as_ref()?, tree))
+    }
+
+    /// The weights of the children of `node` at depth `depth` of `seg` and
+    /// the lanes for the level below ([`Segment::child_weights`]), an
+    /// instance's leaf in the top tree weighed by its mesh root's children.
+    #[inline(always)]
+    pub(crate) fn child_weights(
+        &self,
+        seg: &Segment,
+        node: WalkNode,
+        depth: u32,
+        carried: Option<(Lanes, usize)>,
+    ) -> (Option<(f64, f64)>, Option<Lanes>) {
+        let instances = self.instanced().map(|(tables, _)| tables);
+        seg.child_weights(node, depth, carried, |i, fast| {
+            instances?.root_lanes(i, fast)
+        })
     }
 
     /// Where a walk at `node` of `seg` goes on when `node` is the top

@@ -5,126 +5,28 @@
 //! order of the GLT's walk table, so one 64-byte cache line holds both
 //! children a walk step compares.
 
+use super::child_weights::{Lanes, lanes};
+use super::config::ImportanceBound;
+use super::entry::{COS_SLACK, Entry, OMNI, TWO_SIDED, decode, from_bf16};
 use crate::light_sampler::BACK_FACTOR;
 use crate::light_sampler::ShadingContext;
 use crate::light_tree::{LightHierarchy, NodeBounds};
-use crate::math::scalar::{acos, sqrt};
+use crate::math::scalar::sqrt;
 use alloc::vec::Vec;
-use bytemuck::{Pod, Zeroable};
 use glam::{Mat3A, Vec3, Vec3A};
-
-/// Slack on the emission-angle test, beyond the widening of the stored
-/// cones: `f32` rounding must never decide that a cluster cannot reach a
-/// point that the exact bound says it reaches (the importance is then 0
-/// and, with an importance prior, so is the pmf).
-pub(crate) const COS_SLACK: f32 = 1e-4;
-
-/// The angle by which stored normal cones are widened, covering the error
-/// of the 16-bit axis (at most ~3e-5 rad) with margin.
-const AXIS_WIDENING: f32 = 1e-4;
-
-/// Scale of the 16-bit signed-normalised codes.
-const SNORM: f32 = 32767.0;
-
-/// The cone covers every direction (no orientation factor).
-const OMNI: u16 = 1;
-/// An emitter below is two-sided.
-const TWO_SIDED: u16 = 2;
-
-/// One node, as the importance needs it: 32 bytes.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-#[repr(C)]
-struct Entry {
-    center: [f32; 3],
-    /// Squared radius of the box's bounding sphere.
-    radius2: f32,
-    /// The cone axis, signed-normalised.
-    axis: [i16; 3],
-    flags: u16,
-    /// `1 - cos theta_o` of the widened cone as a bfloat16, rounded up
-    /// (relative precision 2^-8 in the angle's square, so narrow cones
-    /// keep their angle to ~0.2%).
-    one_minus_cos_o: u16,
-    /// `1 - cos theta_e` as a bfloat16, rounded up.
-    one_minus_cos_e: u16,
-    /// Total power; 0 for a node that cannot contribute (no power, empty
-    /// or non-finite box) or that does not exist.
-    power: f32,
-}
-
-const _: () = assert!(core::mem::size_of::<Entry>() == 32);
 
 /// Both children of a light-tree node: one cache line.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C, align(64))]
 struct Pair([Entry; 2]);
 
-/// `x` in `[0, 2]` as a bfloat16 (the high half of its `f32` bits),
-/// rounded up.
-fn bf16_up(x: f32) -> u16 {
-    let bits = x.clamp(0.0, 2.0).to_bits();
-    let high = (bits >> 16) as u16;
-    if bits & 0xffff != 0 { high + 1 } else { high }
-}
-
-#[inline(always)]
-pub(crate) fn from_bf16(b: u16) -> f32 {
-    f32::from_bits(u32::from(b) << 16)
-}
-
-/// The nearest code of `c` in `[-1, 1]`.
-fn snorm(c: f32) -> i16 {
-    libm::roundf(c.clamp(-1.0, 1.0) * SNORM) as i16
-}
-
-#[inline(always)]
-pub(crate) fn decode(q: i16) -> f32 {
-    q as f32 * (1.0 / SNORM)
-}
-
-impl Entry {
-    fn new(b: &NodeBounds) -> Self {
-        let (lo, hi) = (b.bounds.min, b.bounds.max);
-        let valid = b.power > 0.0
-            && b.power.is_finite()
-            && lo.is_finite()
-            && hi.is_finite()
-            && !b.bounds.is_empty();
-        if !valid {
-            return Self::default();
-        }
-        let axis = b.cone.axis.try_normalize();
-        let cos_o = b.cone.cos_theta_o.clamp(-1.0, 1.0);
-        let theta_o = acos(cos_o) + AXIS_WIDENING;
-        let mut flags = if b.two_sided { TWO_SIDED } else { 0 };
-        let (axis, one_minus_cos_o) = match axis {
-            Some(a) if theta_o < core::f32::consts::PI => (
-                [snorm(a.x), snorm(a.y), snorm(a.z)],
-                // 1 - cos = 2 sin^2(theta / 2), exact for small angles.
-                bf16_up(2.0 * libm::powf(libm::sinf(0.5 * theta_o), 2.0)),
-            ),
-            _ => {
-                flags |= OMNI;
-                ([0; 3], bf16_up(2.0))
-            }
-        };
-        Self {
-            center: (lo * 0.5 + hi * 0.5).to_array(),
-            radius2: (0.5 * (hi - lo)).length_squared(),
-            axis,
-            flags,
-            one_minus_cos_o,
-            one_minus_cos_e: bf16_up(1.0 - b.cone.cos_theta_e.clamp(-1.0, 1.0)),
-            power: b.power,
-        }
-    }
-}
-
 /// Every inner node's children decoded for [`ImportanceTable::pair_importance`],
 /// indexed like the GLT's walk table.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ImportanceTable {
     pairs: Vec<Pair>,
+    /// The bound the rules weigh children by.
+    pub(crate) bound: ImportanceBound,
 }
 
 /// A shading point prepared for many evaluations.
@@ -211,14 +113,16 @@ impl ImportanceTable {
     pub(crate) fn new<H: LightHierarchy + ?Sized>(
         tree: &H,
         pairs: impl Iterator<Item = Option<[u32; 2]>>,
+        bound: ImportanceBound,
     ) -> Self {
-        Self::from_bounds(pairs, |n| tree.node_bounds(n))
+        Self::from_bounds(pairs, |n| tree.node_bounds(n), bound)
     }
 
     /// [`ImportanceTable::new`] with each node's bounds from `bounds`.
     pub(crate) fn from_bounds(
         pairs: impl Iterator<Item = Option<[u32; 2]>>,
         bounds: impl Fn(u32) -> NodeBounds,
+        bound: ImportanceBound,
     ) -> Self {
         let pairs = pairs
             .map(|p| match p {
@@ -226,7 +130,7 @@ impl ImportanceTable {
                 None => Pair::default(),
             })
             .collect();
-        Self { pairs }
+        Self { pairs, bound }
     }
 
     /// The two entries of walk-table pair `pair` as stored (32 bytes each:
@@ -246,6 +150,34 @@ impl ImportanceTable {
         self.pairs.len() * core::mem::size_of::<Pair>()
     }
 
+    /// The raw lanes at `q` of the four grandchildren of the node whose
+    /// children are walk-table pair `pair` and whose children's children
+    /// are the pairs `children` (`None` for a leaf child: itself, then an
+    /// empty lane); `None` out of range and at a point that is not finite.
+    #[inline(always)]
+    pub(crate) fn grandchild_lanes(
+        &self,
+        q: &FastQuery,
+        pair: u32,
+        children: [Option<u32>; 2],
+    ) -> Option<Lanes> {
+        if !q.finite {
+            return None;
+        }
+        let side = |s: usize| -> Option<[&Entry; 2]> {
+            match children[s] {
+                Some(k) => self.pairs.get(k as usize).map(|Pair([l, r])| [l, r]),
+                None => Some([&self.pairs.get(pair as usize)?.0[s], &Entry::EMPTY]),
+            }
+        };
+        let ([a, b], [c, d]) = (side(0)?, side(1)?);
+        Some(lanes(
+            q.p.to_array(),
+            q.n.map(|n| n.to_array()),
+            [a, b, c, d],
+        ))
+    }
+
     /// The importances at `q` of the two nodes of walk-table pair `pair`
     /// (0 for pairs out of range).
     ///
@@ -259,6 +191,19 @@ impl ImportanceTable {
             Some(Pair([l, r])) if q.finite => (importance(q, l), importance(q, r)),
             _ => (0.0, 0.0),
         }
+    }
+
+    /// The raw lanes at `q` of the two nodes of walk-table pair `pair`, in
+    /// lanes 0 and 1 (side 0 of [`Lanes::side`]); `None` out of range and
+    /// at a point that is not finite.
+    #[inline(always)]
+    pub(crate) fn child_lanes(&self, q: &FastQuery, pair: u32) -> Option<Lanes> {
+        let Pair([l, r]) = self.pairs.get(pair as usize).filter(|_| q.finite)?;
+        Some(lanes(
+            q.p.to_array(),
+            q.n.map(|n| n.to_array()),
+            [l, r, &Entry::EMPTY, &Entry::EMPTY],
+        ))
     }
 }
 
@@ -321,6 +266,7 @@ fn importance(q: &FastQuery, e: &Entry) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use super::super::entry::bf16_up;
     use super::*;
     use crate::emitter::Emitter;
     use crate::light_sampler::importance as exact;
@@ -346,7 +292,7 @@ mod tests {
         let pairs: Vec<Option<[u32; 2]>> = (0..tree.node_count() as u32)
             .map(|n| tree.children(n))
             .collect();
-        let table = ImportanceTable::new(&tree, pairs.iter().copied());
+        let table = ImportanceTable::new(&tree, pairs.iter().copied(), ImportanceBound::Children);
         assert_eq!(table.bytes(), pairs.len() * 64);
         let k = pairs.iter().position(Option::is_some).unwrap() as u32;
         let at = |p: Vec3| table.pair_importance(&FastQuery::new(&ShadingContext::at(p)), k);
@@ -354,24 +300,6 @@ mod tests {
         assert_eq!((l, r), (0.0, 0.0));
         let (l, r) = at(Vec3::new(1.5, 4.0, 0.0));
         assert!(l > 0.0 && r > 0.0);
-    }
-
-    /// Rounding up to bfloat16 keeps values it can represent exactly and
-    /// moves every other one to the next code above: the stored cones are
-    /// never narrower than the tree's, and no wider than they must be.
-    #[test]
-    fn bf16_rounds_up_only_what_it_cannot_hold() {
-        for x in [0.0f32, 0.5, 1.0, 1.5, 2.0, 0.25, 0.0078125] {
-            assert_eq!(from_bf16(bf16_up(x)), x, "{x} is a bfloat16");
-        }
-        for x in [1.0f32 + f32::EPSILON, 0.3, 1.999, 1e-7] {
-            let up = from_bf16(bf16_up(x));
-            let below = f32::from_bits(up.to_bits() - (1 << 16));
-            assert!(up > x && below < x, "{x} rounds up to {up}");
-        }
-        // Out of range is clamped to [0, 2].
-        assert_eq!(from_bf16(bf16_up(-1.0)), 0.0);
-        assert_eq!(from_bf16(bf16_up(7.0)), 2.0);
     }
 
     /// The table's importance follows the exact `f64` bound: never below
@@ -410,7 +338,7 @@ mod tests {
         let pairs: Vec<Option<[u32; 2]>> = (0..tree.node_count() as u32)
             .map(|n| tree.children(n))
             .collect();
-        let table = ImportanceTable::new(&tree, pairs.iter().copied());
+        let table = ImportanceTable::new(&tree, pairs.iter().copied(), ImportanceBound::Children);
         let (mut close, mut total) = (0usize, 0usize);
         for _ in 0..200 {
             let p = Vec3::new(next(), next(), next()) * 30.0 - 15.0;
@@ -441,5 +369,172 @@ mod tests {
             close as f64 >= 0.99 * total as f64,
             "{close} of {total} within 1%"
         );
+    }
+
+    /// Random entries of every kind (points, spheres, one- and two-sided
+    /// areas), powers from 1e-3 to 1e30, and points near, far and inside.
+    fn lane_cases() -> (Vec<Entry>, Vec<FastQuery>) {
+        let mut s = 0x9e37_79b9_u32;
+        let mut next = move || {
+            s ^= s << 13;
+            s ^= s >> 17;
+            s ^= s << 5;
+            (s >> 8) as f32 / (1u32 << 24) as f32
+        };
+        let mut lights = Vec::new();
+        for i in 0..64 {
+            let p = Vec3::new(next(), next(), next()) * 20.0 - 10.0;
+            let n = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+            let power = [1e-3, 1.0, 7.5, 1e30][i % 4];
+            let mut e = match i % 4 {
+                0 => Emitter::point(p, power),
+                1 => Emitter::sphere(p, 0.5, power),
+                _ => Emitter::area(
+                    crate::math::Aabb::new(p, p + Vec3::splat(0.3)),
+                    n,
+                    0.09,
+                    power,
+                ),
+            };
+            e.two_sided = i % 8 == 3;
+            lights.push(e);
+        }
+        // Every node: leaves, and clusters with wide boxes and cones.
+        let tree = LightTree::build(&lights, BuildHeuristic::Saoh).unwrap();
+        let mut entries: Vec<Entry> = (0..tree.node_count() as u32)
+            .map(|n| Entry::new(&tree.node_bounds(n)))
+            .collect();
+        // Points of radius exactly 0 (the tree pads its leaves' boxes), at
+        // which a shading point can sit.
+        for i in 0..8 {
+            entries.insert(
+                8 * i + 1,
+                Entry {
+                    center: [i as f32, 1.0, -2.0],
+                    flags: OMNI,
+                    one_minus_cos_o: bf16_up(2.0),
+                    one_minus_cos_e: bf16_up(1.0),
+                    power: 5.0,
+                    ..Entry::EMPTY
+                },
+            );
+        }
+        let mut points = Vec::new();
+        for i in 0..64 {
+            let p = match i % 4 {
+                0 => Vec3::new(next(), next(), next()) * 30.0 - 15.0,
+                1 => Vec3::new(next(), next(), next()) * 2e4,
+                // Inside a bounding sphere: at a cluster's centre, or at a
+                // point light itself (distance 0 to a sphere of radius 0).
+                2 => {
+                    let points: Vec<&Entry> = entries
+                        .iter()
+                        .filter(|e| e.radius2 == 0.0 && e.power > 0.0)
+                        .collect();
+                    match i % 8 {
+                        2 => Vec3::from_array(points[i % points.len()].center),
+                        _ => Vec3::from_array(entries[i % entries.len()].center),
+                    }
+                }
+                _ => Vec3::new(next(), next(), next()) * 4.0 - 2.0,
+            };
+            let n = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+            let ctx = match i % 3 {
+                0 => ShadingContext::at(p),
+                _ => ShadingContext::on_surface(p, n),
+            };
+            points.push(FastQuery::new(&ctx));
+        }
+        (entries, points)
+    }
+
+    /// Each lane's importance is the scalar bound's (the same `f32` cone
+    /// arithmetic, the quotient kept apart) to 1e-5 relative, for every
+    /// kind of entry and point; every lane is finite and not negative,
+    /// 1e30 W and far points included.
+    #[test]
+    fn each_lane_is_the_scalar_bound() {
+        let (entries, points) = lane_cases();
+        let mut checked = 0;
+        for q in &points {
+            for four in entries.chunks_exact(4) {
+                let l = lanes(
+                    q.p.to_array(),
+                    q.n.map(|n| n.to_array()),
+                    [&four[0], &four[1], &four[2], &four[3]],
+                );
+                for (i, e) in four.iter().enumerate() {
+                    let (got, want) = (l.importance(i), importance(q, e));
+                    assert!(got.is_finite() && got >= 0.0, "lane {i}: {got}");
+                    assert!(
+                        (got - want).abs() <= 1e-5 * want,
+                        "lane {i}: {got}, the scalar bound {want}"
+                    );
+                    checked += usize::from(want > 0.0);
+                }
+            }
+        }
+        assert!(checked > 1000, "only {checked} lanes contribute");
+    }
+
+    /// A lane's two numbers do not depend on which lane holds the entry or
+    /// on the other lanes (what lets a walk carry its parent's lanes to the
+    /// level below instead of evaluating them again), and the two scalings
+    /// give the bounds' ratios: `sides` the sums of two against two,
+    /// `side` one against one.
+    #[test]
+    fn lanes_are_independent_and_scale_to_the_bounds_ratios() {
+        let (entries, points) = lane_cases();
+        // Ratios lie in [0, 1]: a point light at distance 0 takes all of
+        // the lanes' weight, and nearly all (1e200 to 1) of the scalar's.
+        let close = |got: f64, want: f64| (got - want).abs() <= 1e-5 * want + 1e-12;
+        for q in &points {
+            let (p, n) = (q.p.to_array(), q.n.map(|n| n.to_array()));
+            for k in 0..entries.len() - 3 {
+                let e = [
+                    &entries[k],
+                    &entries[k + 1],
+                    &entries[k + 2],
+                    &entries[k + 3],
+                ];
+                let l = lanes(p, n, e);
+                // The same entries, rotated by one lane.
+                let r = lanes(p, n, [e[1], e[2], e[3], e[0]]);
+                for i in 0..4 {
+                    assert_eq!(
+                        l.importance(i).to_bits(),
+                        r.importance((i + 3) % 4).to_bits(),
+                        "entry {} moved lanes",
+                        k + i
+                    );
+                }
+                let imp: Vec<f64> = (0..4).map(|i| importance(q, e[i])).collect();
+                let (a, b) = l.sides();
+                let (a, b) = (f64::from(a), f64::from(b));
+                assert!(
+                    a.is_finite() && b.is_finite() && a >= 0.0 && b >= 0.0,
+                    "{a} {b}"
+                );
+                if a + b > 0.0 {
+                    let want = (imp[0] + imp[1]) / imp.iter().sum::<f64>();
+                    assert!(close(a / (a + b), want), "{a} {b} against {imp:?}");
+                }
+                for s in 0..2 {
+                    let (x, y) = l.side(s);
+                    let (x, y) = (f64::from(x), f64::from(y));
+                    assert!(
+                        x.is_finite() && y.is_finite() && x >= 0.0 && y >= 0.0,
+                        "{x} {y}"
+                    );
+                    let (ix, iy) = (imp[2 * s], imp[2 * s + 1]);
+                    if ix + iy > 0.0 {
+                        assert!(
+                            close(x / (x + y), ix / (ix + iy)),
+                            "{x} {y} against {ix} {iy}"
+                        );
+                    }
+                }
+            }
+        }
     }
 }

@@ -21,6 +21,8 @@
 //! 1.03x with them, so not kept; and a spot's cone stretched is no
 //! cone.)
 
+use super::child_weights::Lanes;
+use super::config::ImportanceBound;
 use super::importance_table::{FastQuery, ImportanceTable};
 use super::tables::{Segment, TreeTables};
 use super::walk::WalkTable;
@@ -80,6 +82,12 @@ struct InstanceView {
     normal_to_mesh: Mat3A,
     /// Its translation.
     origin: Vec3A,
+    /// The instance's power scale.
+    power_scale: f32,
+    /// The square of its linear scale (`|det|^(2/3)`: the scale itself
+    /// for a transform that keeps angles), which squared distances grow
+    /// by from mesh to world space.
+    distance2_scale: f32,
     mesh: u32,
     view: View,
     emitter_base: u32,
@@ -94,9 +102,10 @@ pub(crate) struct InstancedTables {
 }
 
 impl InstancedTables {
-    /// The tables of `tree`'s meshes, with importance tables when
-    /// `importance`. O(mesh nodes + instances).
-    pub(crate) fn new(tree: &InstancedLightTree, importance: bool) -> Self {
+    /// The tables of `tree`'s meshes, with importance tables weighing
+    /// children by `importance`'s bound when there is one. O(mesh nodes +
+    /// instances).
+    pub(crate) fn new(tree: &InstancedLightTree, importance: Option<ImportanceBound>) -> Self {
         let instances: Vec<InstanceView> = tree
             .placements()
             .iter()
@@ -104,6 +113,11 @@ impl InstancedTables {
                 to_mesh: p.transform.matrix3.inverse(),
                 normal_to_mesh: p.transform.matrix3.transpose(),
                 origin: p.transform.translation,
+                power_scale: p.power_scale,
+                distance2_scale: {
+                    let s = libm::cbrtf(p.transform.matrix3.determinant().abs());
+                    s * s
+                },
                 mesh: p.mesh,
                 view: match (p.similar, p.handedness < 0.0) {
                     (false, _) => View::Unoriented,
@@ -125,12 +139,14 @@ impl InstancedTables {
             .map(|(mesh, used)| {
                 let pairs = WalkTable::pair_nodes(mesh);
                 MeshTables {
-                    tables: TreeTables::new(mesh, false),
+                    tables: TreeTables::new(mesh, None),
                     views: View::ALL.map(|v| {
-                        (importance && used[v as usize]).then(|| {
-                            ImportanceTable::from_bounds(pairs.iter().copied(), |n| {
-                                v.bounds(mesh.node_bounds(n))
-                            })
+                        importance.filter(|_| used[v as usize]).map(|bound| {
+                            ImportanceTable::from_bounds(
+                                pairs.iter().copied(),
+                                |n| v.bounds(mesh.node_bounds(n)),
+                                bound,
+                            )
                         })
                     }),
                 }
@@ -152,6 +168,23 @@ impl InstancedTables {
             None => *fast,
         };
         Some(mesh.tables.segment(importance, fast, Some(i)))
+    }
+
+    /// The raw lanes at `fast` (in world space) of the two children of
+    /// instance `i`'s mesh root, in lanes 0 and 1, brought to world space
+    /// by the instance's power and distance scales (`Lanes::with_side`
+    /// applies them): what the top tree weighs the instance's leaf by where
+    /// the flattened tree would weigh the mesh root by its children
+    /// (`ImportanceBound::Grandchildren`). `None` where the mesh root is a
+    /// leaf (the leaf's own bound stands), out of range and without an
+    /// importance table.
+    #[inline]
+    pub(crate) fn root_lanes(&self, i: u32, fast: &FastQuery) -> Option<(Lanes, f32, f32)> {
+        let seg = self.segment(i, fast)?;
+        let k = seg.walk.root()?.children()?;
+        let v = self.instances.get(i as usize)?;
+        let lanes = seg.importance?.child_lanes(&seg.fast, k)?;
+        Some((lanes, v.power_scale, v.distance2_scale))
     }
 
     /// The emitter id of emitter `t` of instance `i`'s mesh.

@@ -53,9 +53,11 @@
 //! [`CutConfig::with_paper_rules`] gives the paper's one distribution per
 //! cell.
 
+mod child_weights;
 mod config;
 mod cut_node;
 mod cut_rules;
+mod entry;
 mod guiding_cut;
 mod importance_table;
 mod instanced_tables;
@@ -70,16 +72,15 @@ mod vertex;
 mod visibility;
 mod walk;
 
-pub use config::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
+pub use config::{BelowCut, CutConfig, ImportanceBound, Modulation, Prior, SplitPrior};
 pub use cut_node::{CutNode, Slot};
 pub use cut_rules::CutRules;
 pub use guiding_cut::{CutError, CutMemory, GuidingCut};
 pub(crate) use octants::OctantRecords;
 pub(crate) use tables::TreeTables;
-// The f32 cone arithmetic of the decoded bounds, shared with the GPU
-// snapshot's importance (`src/snapshot/importance.rs`).
-pub(crate) use importance_table::{
-    COS_SLACK, cos_sub_clamped, decode, from_bf16, sin_of, sin_sub_clamped,
-};
+// The importance lanes and their record, shared with the GPU snapshot
+// (`src/snapshot/importance.rs`).
+pub(crate) use child_weights::lanes;
+pub(crate) use entry::Entry;
 pub(crate) use vertex::LightCells;
 pub use vertex::LightVertex;

@@ -2,7 +2,7 @@
 //! (`src/persist/mod.rs` has the header, `docs/format.md` the layout);
 //! the GLT and the field save their cells' cuts through these.
 
-use super::config::{BelowCut, CutConfig, Modulation, Prior, SplitPrior};
+use super::config::{BelowCut, CutConfig, ImportanceBound, Modulation, Prior, SplitPrior};
 use super::cut_node::CutNode;
 use super::cut_rules::CutRules;
 use super::guiding_cut::{GuidingCut, MIN_VISIBILITY, anchor_sums, sum_count, visibility_slots};
@@ -12,6 +12,9 @@ use crate::math::ACCUMULATION;
 use crate::math::{Counter, SumBuffer};
 use crate::persist::{LoadError, Reader, Writer, tag, untag};
 use alloc::vec::Vec;
+
+/// The bounds in the order of their tags.
+const BOUNDS: [ImportanceBound; 2] = [ImportanceBound::Children, ImportanceBound::Grandchildren];
 
 impl CutConfig {
     pub(crate) fn write(&self, w: &mut Writer) {
@@ -35,6 +38,7 @@ impl CutConfig {
         w.u8(tag(&ACCUMULATION, self.accumulation));
         w.u32(self.min_records);
         w.bool(self.visibility);
+        w.u8(tag(&BOUNDS, self.importance_bound));
     }
 
     pub(crate) fn read(r: &mut Reader<'_>) -> Result<Self, LoadError> {
@@ -66,6 +70,13 @@ impl CutConfig {
             min_records: r.u32("cut config: min_records")?,
             // Version 1 had no learned visibility.
             visibility: r.version() >= 2 && r.bool("cut config: visibility")?,
+            // Before version 6 every importance weighed children by their
+            // own bounds: files of those versions keep answering as they
+            // did.
+            importance_bound: match r.version() >= 6 {
+                true => untag(r, "cut config: importance_bound", &BOUNDS)?,
+                false => ImportanceBound::Children,
+            },
         };
         config.validate().map_err(|e| e.at(at))?;
         Ok(config)

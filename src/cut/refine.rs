@@ -28,6 +28,9 @@ struct Task<'a> {
     /// and its walk-table entry there (locates its children's pair).
     seg: Segment<'a>,
     walk: WalkNode,
+    /// The walk-table entry's depth in the hierarchy (inside an instance,
+    /// the top tree's levels and the mesh's, as in the flattened tree).
+    depth: u32,
     weight: f64,
     old: Option<u32>,
 }
@@ -275,6 +278,7 @@ fn rebuild<'a, H: LightHierarchy>(
         light: root,
         seg,
         walk,
+        depth: 0,
         weight: total,
         old: (!old.is_empty()).then_some(0),
     }];
@@ -286,7 +290,7 @@ fn rebuild<'a, H: LightHierarchy>(
             // function sampling modulates with, the anchor seen as the
             // walk sees the point (in mesh space inside an instance).
             let imp = anchor
-                .and_then(|_| t.seg.child_importances(t.walk))
+                .and_then(|_| guide.child_weights(&t.seg, t.walk, t.depth, None).0)
                 .and_then(floored);
             // Each side's weight and the old node that stands for it.
             let sides: [(f64, Option<u32>); 2] = match t.old.and_then(|i| old.get(i as usize)) {
@@ -322,6 +326,7 @@ fn rebuild<'a, H: LightHierarchy>(
                 let walks = t.seg.walk.pair(pair).0;
                 for side in [Side::Right, Side::Left] {
                     let (weight, old) = sides[side.index()];
+                    // A mesh's root is as deep as its instance's leaf.
                     let (seg, walk) = place(t.seg, walks[side.index()]);
                     stack.push(Task {
                         parent: index,
@@ -329,6 +334,7 @@ fn rebuild<'a, H: LightHierarchy>(
                         light: children[side.index()],
                         seg,
                         walk,
+                        depth: t.depth + 1,
                         weight,
                         old,
                     });

@@ -35,6 +35,7 @@
 //! these two functions along the emitter's path, so the pmf `sample` returns
 //! equals [`CutRules::pmf_exact`] bit for bit, fallbacks included.
 
+use super::child_weights::Lanes;
 use super::config::{BelowCut, CutConfig, Modulation, Prior};
 use super::cut_node::CutNode;
 use super::cut_rules::CutRules;
@@ -229,6 +230,26 @@ struct Walk {
     at: Cursor,
     p: Products,
     in_cut: Option<u32>,
+    /// The depth of `at` in the whole hierarchy (inside an instance, the
+    /// top tree's levels and the mesh's, as in the flattened tree): the
+    /// parity the importance rule weighs by (`child_weights.rs`).
+    depth: u32,
+}
+
+/// Where a pmf walk is in the hierarchy: its depth (the parity the
+/// importance rule weighs by) and the lanes its last level evaluated, with
+/// the side it took there.
+#[derive(Clone, Copy)]
+struct Depth {
+    depth: u32,
+    carry: Option<(Lanes, usize)>,
+}
+
+impl Depth {
+    /// At depth `depth`, nothing carried.
+    fn at(depth: u32) -> Self {
+        Self { depth, carry: None }
+    }
 }
 
 /// The probabilities at one inner light-tree node.
@@ -510,6 +531,34 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
             .map(|c| c.and_then(|i| self.nodes.get(i as usize).copied()))
     }
 
+    /// Whether a rule reads the importance at `at`.
+    #[inline(always)]
+    fn needs_importance(&self, at: &Cursor) -> bool {
+        self.prior_importance
+            || match at.cut {
+                Some(_) => self.modulate,
+                None => self.below == BelowCut::Importance,
+            }
+    }
+
+    /// The importance weights of the children at `at`, at depth `depth` of
+    /// segment `seg`, from the lanes `carried` from its parent
+    /// ([`Segment::child_weights`]), when a rule reads them; and the lanes
+    /// for the level below.
+    #[inline(always)]
+    fn weights(
+        &self,
+        seg: &Segment,
+        at: &Cursor,
+        depth: u32,
+        carried: Option<(Lanes, usize)>,
+    ) -> (Option<(f64, f64)>, Option<Lanes>) {
+        match self.needs_importance(at) {
+            true => self.guide.child_weights(seg, at.node, depth, carried),
+            false => (None, None),
+        }
+    }
+
     /// The probabilities of both components at the inner node `at` of
     /// segment `seg`, whose split-table entry is `split`.
     ///
@@ -525,17 +574,8 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
     ///
     /// Light sets restrict it afterwards ([`Restriction::restrict`]).
     #[inline(always)]
-    fn step(&self, seg: &Segment, at: Cursor, split: f32) -> Step {
-        let needs_importance = self.prior_importance
-            || match at.cut {
-                Some(_) => self.modulate,
-                None => self.below == BelowCut::Importance,
-            };
-        let imp = if needs_importance {
-            seg.child_importances(at.node)
-        } else {
-            None
-        };
+    fn step(&self, at: Cursor, split: f32, imp: Option<(f64, f64)>) -> Step {
+        let needs_importance = self.needs_importance(&at);
         // The power split is decoded only where a rule falls back to it
         // (callgrind on trained city cuts: 436 instructions a sample when
         // decoded at every level, docs/benchmarks.md).
@@ -643,6 +683,7 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
             // The cut node the walk is in (the root's only slot when the
             // cut has no nodes).
             in_cut: at.cut.filter(|_| SUM).map(|_| 0u32),
+            depth: 0,
         };
         if SUM {
             *sum = 0;
@@ -674,9 +715,10 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
     ) -> Option<()> {
         let walk = seg.walk;
         // A copy the loop keeps in registers, written back at the end.
-        let (mut at, mut p, mut in_cut) = (w.at, w.p, w.in_cut);
+        let (mut at, mut p, mut in_cut, mut depth) = (w.at, w.p, w.in_cut, w.depth);
         let mut children = at.node.children().map(|k| walk.pair(k));
-        let mut level = 0;
+        // The lanes the last level evaluated and the side taken there.
+        let mut carry: Option<(Lanes, usize)> = None;
         while let Some(pair) = children {
             // Load the next level for both sides before choosing: these
             // loads do not depend on `u`, so they overlap with this level's
@@ -684,23 +726,29 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
             let grand = walk.grandchildren(pair);
             let split = at.node.split;
             let compute = || {
-                self.restriction
-                    .restrict(self.step(seg, at, split), split, || {
+                let (imp, lanes) = self.weights(seg, &at, depth, carry);
+                let step = self
+                    .restriction
+                    .restrict(self.step(at, split, imp), split, || {
                         at.node.children().map(|k| seg.pair_sets(k))
-                    })
+                    });
+                (step, lanes)
             };
-            let step = match M::ACTIVE {
+            let (step, lanes) = match M::ACTIVE {
                 // One sample: the loop as if there were no memo.
                 false => compute(),
                 true => {
+                    // A remembered step comes without its lanes: the level
+                    // below evaluates its own (the same bits).
                     let key = at.node.children().unwrap_or(u32::MAX);
-                    let step = memo.get(level, key).unwrap_or_else(|| {
-                        let step = compute();
-                        memo.put(level, key, step);
-                        step
-                    });
-                    level += 1;
-                    step
+                    match memo.get(depth as usize, key) {
+                        Some(step) => (step, None),
+                        None => {
+                            let (step, lanes) = compute();
+                            memo.put(depth as usize, key, step);
+                            (step, lanes)
+                        }
+                    }
                 }
             };
             let cuts = self.cut_children(&step);
@@ -708,6 +756,8 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
             let side = d.choose_with(pl, pr);
             self.apply(&mut p, &step, side);
             let k = side.index();
+            carry = lanes.map(|l| (l, k));
+            depth += 1;
             if let Some(i) = in_cut {
                 in_cut = step.next[k];
                 if in_cut.is_none() {
@@ -720,7 +770,12 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
             };
             children = at.node.children().map(|_| grand[k]);
         }
-        *w = Walk { at, p, in_cut };
+        *w = Walk {
+            at,
+            p,
+            in_cut,
+            depth,
+        };
         Some(())
     }
 
@@ -739,7 +794,7 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
     ) -> Option<u32> {
         let seg = tables.segment(i, &self.top.fast)?;
         w.at.node = seg.walk.root()?;
-        // Keys name nodes of the top segment only.
+        // Keys name nodes of the top segment only, at its depths.
         self.descend::<SUM, _>(&seg, w, &mut d, use_cut, sum, &mut NoMemo)?;
         tables.emitter_id(i, w.at.node.emitter()?)
     }
@@ -772,7 +827,7 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
             (None, None) => self
                 .tree
                 .path(emitter)
-                .is_some_and(|path| self.pmf_along(&self.top, &mut at, &mut p, path.steps())),
+                .is_some_and(|path| self.pmf_along(&self.top, &mut at, &mut p, path.steps(), 0)),
             (Some((tables, tree)), _) => self.pmf_instanced(tables, tree, emitter, &mut at, &mut p),
         };
         match found {
@@ -801,7 +856,7 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
         else {
             return false;
         };
-        if !self.pmf_along(&self.top, at, p, top.steps()) {
+        if !self.pmf_along(&self.top, at, p, top.steps(), 0) {
             return false;
         }
         let Some(seg) = tables.segment(i, &self.top.fast) else {
@@ -811,7 +866,9 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
             return false;
         };
         at.node = root;
-        self.pmf_along(&seg, at, p, inner.steps())
+        // The mesh's root is as deep as the instance's leaf above it.
+        let depth = top.steps().len() as u32;
+        self.pmf_along(&seg, at, p, inner.steps(), depth)
     }
 
     /// [`Rule::pmf_along`] the path `code` gives, down the walk table from
@@ -819,12 +876,13 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
     /// split table holds, so the products are the ones `sample` forms).
     #[inline(always)]
     fn pmf_coded(&self, seg: &Segment, at: &mut Cursor, p: &mut Products, code: PathCode) -> bool {
+        let mut depth = Depth::at(0);
         for level in 0..code.depth() {
             let Some(k) = at.node.children() else {
                 return false;
             };
             let side = code.side(level);
-            if !self.pmf_step(seg, at, p, at.node.split, side) {
+            if !self.pmf_step(seg, at, p, at.node.split, side, &mut depth) {
                 return false;
             }
             at.node = seg.walk.pair(k).0[side.index()];
@@ -833,9 +891,9 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
     }
 
     /// One level of a pmf walk at `at`, whose node's split-table entry is
-    /// `split`: multiplies the probabilities of `side` into `p` and moves
-    /// `at`'s cut node to that side (the caller moves its walk-table
-    /// entry); false once both products are 0.
+    /// `split`, at `depth`: multiplies the probabilities of `side` into `p`
+    /// and moves `at`'s cut node and `depth` to that side (the caller moves
+    /// its walk-table entry); false once both products are 0.
     #[inline(always)]
     fn pmf_step(
         &self,
@@ -844,11 +902,17 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
         p: &mut Products,
         split: f32,
         side: Side,
+        depth: &mut Depth,
     ) -> bool {
         let pair = at.node.children();
+        let (imp, lanes) = self.weights(seg, at, depth.depth, depth.carry);
+        *depth = Depth {
+            depth: depth.depth + 1,
+            carry: lanes.map(|l| (l, side.index())),
+        };
         let step = self
             .restriction
-            .restrict(self.step(seg, *at, split), split, || {
+            .restrict(self.step(*at, split, imp), split, || {
                 pair.map(|k| seg.pair_sets(k))
             });
         self.apply(p, &step, side);
@@ -860,8 +924,8 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
     }
 
     /// Multiplies into `p` the steps along `path` in segment `seg`, from
-    /// `at`; false as soon as both products are 0 (or the walk table does
-    /// not follow the path).
+    /// `at` at depth `depth` of the hierarchy; false as soon as both
+    /// products are 0 (or the walk table does not follow the path).
     ///
     /// The path names every node, so the split loads are independent of
     /// each other (unlike the walk table's chain, which `sample` follows
@@ -873,12 +937,14 @@ impl<'b, H: LightHierarchy, R: Restriction> Rule<'b, H, R> {
         at: &mut Cursor,
         p: &mut Products,
         path: &[(u32, Side)],
+        depth: u32,
     ) -> bool {
         // Follow the walk table too (the importance table and the light
         // sets are laid out like it), only when they are read.
         let follow = seg.importance.is_some() || R::LINKED;
+        let mut depth = Depth::at(depth);
         for &(node, side) in path {
-            if !self.pmf_step(seg, at, p, seg.raw_split(node), side) {
+            if !self.pmf_step(seg, at, p, seg.raw_split(node), side, &mut depth) {
                 return false;
             }
             if follow {

@@ -8,6 +8,8 @@
 //! segments: the top tree to an instance's leaf, then its mesh's tree with
 //! the point moved into mesh space.
 
+use super::child_weights::Lanes;
+use super::config::ImportanceBound;
 use super::importance_table::{FastQuery, ImportanceTable};
 use super::split_table::encode_split;
 use super::walk::{WalkNode, WalkTable};
@@ -32,9 +34,12 @@ pub(crate) struct TreeTables {
 }
 
 impl TreeTables {
-    /// The tables of `tree`, the importance table only when `importance`.
-    /// O(nodes).
-    pub(crate) fn new<T: LightHierarchy + ?Sized>(tree: &T, importance: bool) -> Self {
+    /// The tables of `tree`, the importance table (weighing children by
+    /// `importance`'s bound) only when there is one. O(nodes).
+    pub(crate) fn new<T: LightHierarchy + ?Sized>(
+        tree: &T,
+        importance: Option<ImportanceBound>,
+    ) -> Self {
         let split: Vec<f32> = (0..tree.node_count() as u32)
             .map(|n| match tree.children(n) {
                 Some([l, r]) => encode_split(tree.power(l), tree.power(r)),
@@ -42,8 +47,8 @@ impl TreeTables {
             })
             .collect();
         let walk = WalkTable::new(tree, |n| split.get(n as usize).copied().unwrap_or(f32::NAN));
-        let importance =
-            importance.then(|| ImportanceTable::new(tree, WalkTable::pair_nodes(tree).into_iter()));
+        let importance = importance
+            .map(|b| ImportanceTable::new(tree, WalkTable::pair_nodes(tree).into_iter(), b));
         let pair_sets = match tree.has_light_sets() {
             false => Vec::new(),
             true => WalkTable::pair_nodes(tree)
@@ -139,14 +144,59 @@ impl Segment<'_> {
         }
     }
 
-    /// The importances at the point of the two children of the inner node
-    /// `node`, from the decoded table (both in one cache line, found by
-    /// the walk-table pair); `None` without a table or at a leaf.
+    /// The weights at the point of the two children of the inner node
+    /// `node` at depth `depth` of this segment's tree, by the table's
+    /// [`ImportanceBound`], and the lanes it evaluated for the level below.
+    /// With [`ImportanceBound::Grandchildren`]: at even depth by the four
+    /// grandchildren's lanes (returned), at odd depth by the children's own
+    /// two lanes, those `carried` from the parent (with the side the walk
+    /// took there) or, without, evaluated here: the same bits either way.
+    /// In the top tree of an instanced hierarchy a leaf child is an
+    /// instance, and `root_lanes` gives its mesh root's children's lanes
+    /// and their scales (`InstancedTables::root_lanes`), which stand for
+    /// it as in the flattened tree (`None` for a flat hierarchy: the
+    /// leaf's own bound stands).
+    /// `None` without a table or at a leaf.
     #[inline(always)]
-    pub(crate) fn child_importances(&self, node: WalkNode) -> Option<(f64, f64)> {
-        Some(
-            self.importance?
-                .pair_importance(&self.fast, node.children()?),
-        )
+    pub(crate) fn child_weights(
+        &self,
+        node: WalkNode,
+        depth: u32,
+        carried: Option<(Lanes, usize)>,
+        root_lanes: impl Fn(u32, &FastQuery) -> Option<(Lanes, f32, f32)>,
+    ) -> (Option<(f64, f64)>, Option<Lanes>) {
+        let Some(table) = self.importance else {
+            return (None, None);
+        };
+        let Some(k) = node.children() else {
+            return (None, None);
+        };
+        if table.bound == ImportanceBound::Children {
+            return (Some(table.pair_importance(&self.fast, k)), None);
+        }
+        let wide = |(l, r): (f32, f32)| (f64::from(l), f64::from(r));
+        if depth % 2 == 0 {
+            let nodes = self.walk.pair(k).0;
+            let children = nodes.map(WalkNode::children);
+            let mut lanes = table.grandchild_lanes(&self.fast, k, children);
+            // An instance's leaf weighs as its mesh root would in the
+            // flattened tree: by the root's children, seen from mesh space.
+            if let Some(l) = lanes.as_mut().filter(|_| self.instance.is_none()) {
+                for (s, node) in nodes.iter().enumerate() {
+                    let inner = node.emitter();
+                    if let Some((m, power, distance2)) =
+                        inner.and_then(|i| root_lanes(i, &self.fast))
+                    {
+                        *l = l.with_side(s, m, power, distance2);
+                    }
+                }
+            }
+            return (lanes.map(|l| wide(l.sides())), lanes);
+        }
+        let own = match carried {
+            Some((lanes, side)) => Some(lanes.side(side)),
+            None => table.child_lanes(&self.fast, k).map(|l| l.side(0)),
+        };
+        (own.map(wide), None)
     }
 }

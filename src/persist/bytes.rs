@@ -8,7 +8,7 @@ use alloc::vec::Vec;
 pub(crate) const MAGIC: [u8; 8] = *b"GUIDING\0";
 
 /// The format version this build writes, and the newest it reads.
-pub(crate) const FORMAT_VERSION: u32 = 5;
+pub(crate) const FORMAT_VERSION: u32 = 6;
 
 /// Bytes of the header: magic, format version, crate version (three
 /// `u16`), kind, payload length, checksum.

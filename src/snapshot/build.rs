@@ -2,11 +2,11 @@
 //! shared light-tree tables copied into the plain-data arrays.
 
 use super::layout::{
-    BELOW_IMPORTANCE, Bounds, BoundsPair, Cell, Header, LEAF, MAGIC, MODULATED, PRIOR,
-    PRIOR_IMPORTANCE, TreeEntry, TreePair, VERSION,
+    BELOW_IMPORTANCE, Bounds, BoundsPair, Cell, GRANDCHILDREN, Header, LEAF, MAGIC, MODULATED,
+    PRIOR, PRIOR_IMPORTANCE, TreeEntry, TreePair, VERSION,
 };
 use super::{Snapshot, SnapshotError};
-use crate::cut::{BelowCut, CutNode, CutRules, GuidingCut, Prior, TreeTables};
+use crate::cut::{BelowCut, CutNode, CutRules, GuidingCut, ImportanceBound, Prior, TreeTables};
 use crate::light_tree::LightHierarchy;
 use crate::spatial::{BinaryTree, SpatialTree};
 use alloc::vec;
@@ -83,6 +83,10 @@ impl Snapshot {
                 PRIOR_IMPORTANCE
             } else {
                 0
+            } | if config.importance_bound == ImportanceBound::Grandchildren {
+                GRANDCHILDREN
+            } else {
+                0
             },
             unbounded: index(k, "unbounded lights")?,
             root_min: root.min.to_array(),
@@ -156,23 +160,20 @@ fn light_tree_arrays(tables: &TreeTables, emitters: usize) -> Result<TreeArrays,
     Ok((pairs, first_right, leaf_position))
 }
 
-/// The importance table's entries with each pair's powers relative to the
-/// larger; none when no rule reads importance.
+/// The importance table's entries as it holds them (the lanes of
+/// `src/cut/child_weights.rs` read them as they are: weighing a child by
+/// its children compares records of different pairs, so no pair may be
+/// scaled on its own); none when no rule reads importance.
 fn bounds_pairs(tables: &TreeTables, pairs: usize) -> Vec<BoundsPair> {
     let Some(table) = tables.importance() else {
         return Vec::new();
     };
     (0..pairs)
-        .map(|k| {
-            let mut nodes: [Bounds; 2] = match table.entry_bytes(k) {
+        .map(|k| BoundsPair {
+            nodes: match table.entry_bytes(k) {
                 Some(bytes) => bytes.map(|b| bytemuck::pod_read_unaligned(&b)),
                 None => [Bounds::default(); 2],
-            };
-            let max = nodes[0].power.max(nodes[1].power);
-            for b in &mut nodes {
-                b.power = if max > 0.0 { b.power / max } else { 0.0 };
-            }
-            BoundsPair { nodes }
+            },
         })
         .collect()
 }

@@ -15,7 +15,7 @@ pub const MAGIC: u32 = u32::from_le_bytes(*b"GLTS");
 
 /// The layout version this crate writes and reads. A change of any record
 /// below, or of what a field means, bumps it (docs/format.md).
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 
 /// The top bit of a link word: set, the low 31 bits name a cell
 /// ([`Header`]'s spatial nodes) or an emitter ([`TreeEntry::link`]).
@@ -31,6 +31,10 @@ pub const BELOW_IMPORTANCE: u32 = 1;
 /// [`Header::flags`]: the prior component is the light tree by importance
 /// at the shading point (else by power).
 pub const PRIOR_IMPORTANCE: u32 = 2;
+/// [`Header::flags`]: importance weighs a node's children by their
+/// children's bounds at even depths (`ImportanceBound::Grandchildren`,
+/// new in version 2; else by their own bounds at every depth).
+pub const GRANDCHILDREN: u32 = 4;
 
 /// [`Cell::flags`]: the cut's probabilities follow the importance at the
 /// shading point (a learned ratio times the children's importances).
@@ -53,7 +57,7 @@ pub struct Header {
     pub magic: u32,
     /// [`VERSION`].
     pub version: u32,
-    /// [`BELOW_IMPORTANCE`] | [`PRIOR_IMPORTANCE`].
+    /// [`BELOW_IMPORTANCE`] | [`PRIOR_IMPORTANCE`] | [`GRANDCHILDREN`].
     pub flags: u32,
     /// Unbounded lights `k` (each cell has `k` learned fractions).
     pub unbounded: u32,
@@ -160,9 +164,9 @@ pub struct Bounds {
     pub one_minus_cos_o: u16,
     /// `1 - cos theta_e` (the emission spread), bfloat16 rounded up.
     pub one_minus_cos_e: u16,
-    /// Power relative to the larger of the two siblings (so in `[0, 1]`:
-    /// only the ratio between siblings is ever read, and `f32` products
-    /// stay far from overflow); 0 for a node that cannot contribute.
+    /// Total power, finite (the importance is formed as a numerator and a
+    /// squared distance, never their quotient, so a 1e30 W node stays
+    /// finite in `f32`); 0 for a node that cannot contribute.
     pub power: f32,
 }
 

@@ -4,9 +4,10 @@
 //! the running products in `f32` as a GPU keeps them. The WGSL kernel
 //! (`gpu/src/sample.wgsl`) is this file line for line.
 
-use super::importance::{Point, pair_weights};
+use super::importance::{Point, child_weights};
 use super::layout::{
-    BELOW_IMPORTANCE, Cell, LEAF, MODULATED, NO_EMITTER, PRIOR, PRIOR_IMPORTANCE, TreeEntry,
+    BELOW_IMPORTANCE, Cell, GRANDCHILDREN, LEAF, MODULATED, NO_EMITTER, PRIOR, PRIOR_IMPORTANCE,
+    TreeEntry,
 };
 use super::view::SnapshotView;
 use crate::cut::{CutNode, Slot};
@@ -101,6 +102,8 @@ struct Rule<'v, 'a> {
     cell_index: u32,
     below_importance: bool,
     prior_importance: bool,
+    /// Importance weighs children by their children at even depths.
+    grandchildren: bool,
     modulate: bool,
     prior: bool,
 }
@@ -121,6 +124,7 @@ impl<'v, 'a> Rule<'v, 'a> {
             cell_index,
             below_importance: flags & BELOW_IMPORTANCE != 0,
             prior_importance: flags & PRIOR_IMPORTANCE != 0,
+            grandchildren: flags & GRANDCHILDREN != 0,
             modulate: cell.flags & MODULATED != 0,
             prior: cell.flags & PRIOR != 0,
         })
@@ -142,7 +146,7 @@ impl<'v, 'a> Rule<'v, 'a> {
     /// The probabilities at the inner entry `at` (children pair `k`),
     /// inside the cut at cut node `cut`.
     #[inline(always)]
-    fn step(&self, at: TreeEntry, k: u32, cut: Option<u32>) -> Option<Step> {
+    fn step(&self, at: TreeEntry, k: u32, cut: Option<u32>, depth: u32) -> Option<Step> {
         let power = decode_split(at.split);
         let needs_importance = self.prior_importance
             || match cut {
@@ -150,12 +154,12 @@ impl<'v, 'a> Rule<'v, 'a> {
                 None => self.below_importance,
             };
         let imp = match needs_importance {
-            true => self
-                .view
-                .a
-                .bounds
-                .get(k as usize)
-                .map(|pair| pair_weights(&self.q, pair)),
+            true => {
+                // Without the grandchildren's bound every level weighs as
+                // an odd one does: by the children's own bounds.
+                let depth = if self.grandchildren { depth } else { 1 };
+                child_weights(&self.q, self.view.a.tree, self.view.a.bounds, k, depth)
+            }
             false => None,
         };
         let by_importance = imp.and_then(|(l, r)| probabilities(l, r)).or(power);
@@ -263,9 +267,11 @@ impl<'v, 'a> Rule<'v, 'a> {
         let mut p = (1.0f32, 1.0f32);
         // The slot the walk leaves the cut by (0: the root's only one).
         let mut slot = 0usize;
+        let mut depth = 0;
         while at.link & LEAF == 0 {
             let k = at.link;
-            let step = self.step(at, k, cut)?;
+            let step = self.step(at, k, cut, depth)?;
+            depth += 1;
             let side = d.choose(if use_cut { step.cut } else { step.prior }?);
             self.apply(&mut p, &step, side);
             if let Some(i) = cut {
@@ -348,11 +354,13 @@ impl<'v, 'a> Rule<'v, 'a> {
             return 0.0;
         };
         let mut p = (1.0f32, 1.0f32);
+        let mut depth = 0;
         while at.link & LEAF == 0 {
             let k = at.link;
-            let Some(step) = self.step(at, k, cut) else {
+            let Some(step) = self.step(at, k, cut, depth) else {
                 return 0.0;
             };
+            depth += 1;
             let side = match a.first_right.get(k as usize) {
                 Some(&first) if position >= first => Side::Right,
                 Some(_) => Side::Left,

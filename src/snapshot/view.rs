@@ -177,7 +177,8 @@ fn check(a: &SnapshotArrays) -> Result<(), SnapshotError> {
             b.center.iter().all(|x| x.is_finite())
                 && b.radius2 >= 0.0
                 && b.radius2.is_finite()
-                && unit(b.power)
+                && b.power >= 0.0
+                && b.power.is_finite()
         }),
         "bounds",
     )?;

@@ -1,7 +1,7 @@
 //! The command line.
 
 use clap::Parser;
-use guiding::cut::{BelowCut, Modulation, Prior};
+use guiding::cut::{BelowCut, ImportanceBound, Modulation, Prior};
 use std::path::PathBuf;
 
 /// Renders the paper's scene analogues with every light-sampling and
@@ -66,6 +66,11 @@ pub struct Args {
     /// the crate's default).
     #[arg(long, default_value = "importance", value_parser = parse_modulation)]
     pub modulation: Modulation,
+    /// The bound the GLT's importance rules weigh a node's children by:
+    /// `children` (their own; the crate's default) or `grandchildren`
+    /// (their children's at even depths).
+    #[arg(long, default_value = "children", value_parser = parse_importance_bound)]
+    pub importance_bound: ImportanceBound,
     /// Light records carry the full contribution `f cos Le w / p` instead of
     /// the paper's `Le w / p`.
     #[arg(long)]
@@ -214,6 +219,15 @@ pub fn parse_modulation(s: &str) -> Result<Modulation, String> {
         "none" => Ok(Modulation::None),
         "importance" => Ok(Modulation::Importance),
         _ => Err(format!("`{s}`: expected `none` or `importance`")),
+    }
+}
+
+/// Parses `--importance-bound`.
+pub fn parse_importance_bound(s: &str) -> Result<ImportanceBound, String> {
+    match s {
+        "children" => Ok(ImportanceBound::Children),
+        "grandchildren" => Ok(ImportanceBound::Grandchildren),
+        _ => Err(format!("`{s}`: expected `children` or `grandchildren`")),
     }
 }
 

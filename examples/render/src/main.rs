@@ -116,6 +116,7 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
         min_records: args.min_records,
         alpha: args.alpha,
         modulation: args.modulation,
+        importance_bound: args.importance_bound,
         contribution_records: args.contribution_records,
         glt_filter: if args.glt_jitter {
             SpatialFilter::StochasticBox

@@ -3,7 +3,7 @@
 //! Light Tree and/or an SD-tree is trained.
 
 use crate::scene::Scene;
-use guiding::cut::{BelowCut, CutConfig, Modulation, Prior};
+use guiding::cut::{BelowCut, CutConfig, ImportanceBound, Modulation, Prior};
 use guiding::field::{FieldConfig, GuidingField};
 use guiding::glt::{Glt, GltConfig};
 use guiding::light_sampler::{ImportanceTreeSampler, PowerSampler, UniformSampler, WithUnbounded};
@@ -109,6 +109,8 @@ pub struct GuideParams {
     pub alpha: f64,
     /// Whether the GLT's cut probabilities vary inside a cell.
     pub modulation: Modulation,
+    /// The bound the GLT's importance rules weigh children by.
+    pub importance_bound: ImportanceBound,
     /// Light records carry `f cos Le w / p` (else the paper's `Le w / p`).
     pub contribution_records: bool,
     /// The spatial filter of the light records (`pt-glt`'s GLT and
@@ -144,6 +146,7 @@ impl Default for GuideParams {
             min_records: cut.min_records,
             alpha: cut.alpha,
             modulation: cut.modulation,
+            importance_bound: cut.importance_bound,
             contribution_records: false,
             glt_filter: GltConfig::default().light_filter,
             prior: cut.prior,
@@ -205,6 +208,7 @@ fn cut_config(scene: &Scene, params: &GuideParams) -> CutConfig {
         min_records: params.min_records,
         alpha: params.alpha,
         modulation: params.modulation,
+        importance_bound: params.importance_bound,
         prior: params.prior,
         unbounded: scene.unbounded_lights,
         visibility: params.visibility,

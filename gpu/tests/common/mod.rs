@@ -20,11 +20,21 @@ pub fn city() -> Scene {
 /// A GLT trained on `scene` by the render example's `pt-glt` schedule at
 /// `width` x `height` for `spp` samples per pixel.
 pub fn trained(scene: &Scene, (width, height): (u32, u32), spp: u64) -> Glt<&LightTree> {
+    trained_with(scene, (width, height), spp, GuideParams::default())
+}
+
+/// [`trained`] with the guide's parameters `params`.
+pub fn trained_with(
+    scene: &Scene,
+    (width, height): (u32, u32),
+    spp: u64,
+    params: GuideParams,
+) -> Glt<&LightTree> {
     let settings = run::Settings {
         width,
         height,
         budget: run::Budget::Spp(spp),
-        params: GuideParams::default(),
+        params,
         seed: 1,
         progress: false,
         guide_files: Default::default(),

@@ -1,7 +1,7 @@
 //! A GLT configuration to measure, from a `key=value` list.
 
 use crate::methods::GuideParams;
-use guiding::cut::{BelowCut, Modulation, Prior};
+use guiding::cut::{BelowCut, ImportanceBound, Modulation, Prior};
 use guiding::spatial::SpatialFilter;
 
 /// One GLT configuration and how long it trains.
@@ -27,6 +27,7 @@ impl GltVariant {
 
     /// Parses `spec`: space-separated `key=value` (sigma, alpha,
     /// below=power|importance, modulation=none|importance,
+    /// bound=children|grandchildren,
     /// record=radiance|contribution, filter=nearest|jitter,
     /// prior=power|importance, rules=paper (the paper's rules, see the
     /// render example's `--paper-rules`), min-records, threshold,
@@ -66,6 +67,16 @@ impl GltVariant {
                         [
                             ("none", Modulation::None),
                             ("importance", Modulation::Importance),
+                        ],
+                    )?
+                }
+                "bound" => {
+                    v.params.importance_bound = pick(
+                        kv,
+                        val,
+                        [
+                            ("children", ImportanceBound::Children),
+                            ("grandchildren", ImportanceBound::Grandchildren),
                         ],
                     )?
                 }

@@ -108,8 +108,9 @@ struct Args {
     /// GLT variants besides the defaults: space-separated `key=value`
     /// settings (sigma, alpha, below=power|importance,
     /// modulation=none|importance, prior=power|importance,
-    /// record=radiance|contribution, filter=nearest|jitter, rules=paper,
-    /// min-records, threshold, train-spp); repeat the flag for several.
+    /// bound=children|grandchildren, record=radiance|contribution,
+    /// filter=nearest|jitter, rules=paper, min-records, threshold,
+    /// train-spp); repeat the flag for several.
     #[arg(long)]
     glt: Vec<String>,
     /// Samples per pixel the GLT trains with (the render example's
