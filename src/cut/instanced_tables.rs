@@ -84,9 +84,10 @@ struct InstanceView {
     origin: Vec3A,
     /// The instance's power scale.
     power_scale: f32,
-    /// The square of its linear scale (`|det|^(2/3)`: the scale itself
-    /// for a transform that keeps angles), which squared distances grow
-    /// by from mesh to world space.
+    /// What squared distances grow by from mesh to world space:
+    /// `|det|^(2/3)`, exactly the square of the scale for a transform that
+    /// keeps angles (for one that does not, a weight only, as the
+    /// unoriented view's distances are).
     distance2_scale: f32,
     mesh: u32,
     view: View,
