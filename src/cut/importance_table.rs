@@ -302,6 +302,16 @@ mod tests {
         assert!(l > 0.0 && r > 0.0);
     }
 
+    /// Numbers in `[0, 1)` from a xorshift generator seeded with `seed`.
+    fn uniform(mut s: u32) -> impl FnMut() -> f32 {
+        move || {
+            s ^= s << 13;
+            s ^= s >> 17;
+            s ^= s << 5;
+            (s >> 8) as f32 / (1u32 << 24) as f32
+        }
+    }
+
     /// The table's importance follows the exact `f64` bound: never below
     /// it by more than f32 rounding (it stays conservative, so a node the
     /// exact bound lets contribute is never dropped), within 1% for 99% of
@@ -311,13 +321,7 @@ mod tests {
     /// the emission cosine is near zero).
     #[test]
     fn matches_the_exact_importance_and_stays_conservative() {
-        let mut s = 0x2545_f491_u32;
-        let mut next = move || {
-            s ^= s << 13;
-            s ^= s >> 17;
-            s ^= s << 5;
-            (s >> 8) as f32 / (1u32 << 24) as f32
-        };
+        let mut next = uniform(0x2545_f491);
         let mut lights = Vec::new();
         for i in 0..300 {
             let p = Vec3::new(next(), next(), next()) * 20.0 - 10.0;
@@ -374,13 +378,7 @@ mod tests {
     /// Random entries of every kind (points, spheres, one- and two-sided
     /// areas), powers from 1e-3 to 1e30, and points near, far and inside.
     fn lane_cases() -> (Vec<Entry>, Vec<FastQuery>) {
-        let mut s = 0x9e37_79b9_u32;
-        let mut next = move || {
-            s ^= s << 13;
-            s ^= s >> 17;
-            s ^= s << 5;
-            (s >> 8) as f32 / (1u32 << 24) as f32
-        };
+        let mut next = uniform(0x9e37_79b9);
         let mut lights = Vec::new();
         for i in 0..64 {
             let p = Vec3::new(next(), next(), next()) * 20.0 - 10.0;
