@@ -62,7 +62,7 @@ fn glt_configured() -> GltConfig {
             modulation: Modulation::None,
             prior: Prior::Power,
             split_prior: SplitPrior::Power,
-            importance_bound: ImportanceBound::Grandchildren,
+            importance_bound: ImportanceBound::Children,
             unbounded: UnboundedLights::new(2, 0.25).unwrap(),
             accumulation: Accumulation::Deterministic,
             min_records: 10,

@@ -1274,8 +1274,8 @@ fn modulation_reproduces_the_learned_cut_at_the_anchor_and_follows_importance() 
 /// (the control). Importance is evaluated whatever the prior rule (a
 /// mutant that evaluated it only for an importance prior went unseen).
 /// The light BVH weighs each child by its own bound, so the cut does too
-/// here (`ImportanceBound::Children`; the default's grandchildren are
-/// `child_weights_follow_the_grandchildren`'s).
+/// here (`ImportanceBound::Children`, not the default; the default's
+/// grandchildren are `child_weights_follow_the_grandchildren`'s).
 #[test]
 fn below_cut_importance_is_the_importance_walk() {
     let mut rng = Rand::new(41);

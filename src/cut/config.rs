@@ -109,8 +109,6 @@ pub enum ImportanceBound {
     /// Each child by its own bound (Estevez-Kulla, as pbrt-v4's light
     /// BVH): two evaluations per level of a walk. A file saved before
     /// format version 6 loads with this bound, so it answers as it did.
-    /// The default.
-    #[default]
     Children,
     /// At a node of even depth (the root at 0; over instances, the depth
     /// in the flattened tree, an instance's leaf standing for its mesh
@@ -121,8 +119,8 @@ pub enum ImportanceBound {
     /// vector lanes, once per two levels (`src/cut/child_weights.rs`):
     /// 7-11% lower variance on city and torus and 6-9% fewer instructions
     /// than [`ImportanceBound::Children`] (docs/benchmarks.md, "Weighing a
-    /// child by its children"). Not yet the default: the render
-    /// example's equal-time figures have not been measured with it.
+    /// child by its children"). The default.
+    #[default]
     Grandchildren,
 }
 
@@ -163,7 +161,7 @@ pub struct CutConfig {
     /// `SplitPrior::Half`.
     pub split_prior: SplitPrior,
     /// The bound the importance rules weigh children by. Default
-    /// `ImportanceBound::Children`.
+    /// `ImportanceBound::Grandchildren`.
     pub importance_bound: ImportanceBound,
     /// The scene's unbounded lights (distant and infinite, beside the
     /// emitters) and their prior probability `q` together. Each one's
@@ -209,7 +207,7 @@ impl Default for CutConfig {
             modulation: Modulation::Importance,
             prior: Prior::Importance,
             split_prior: SplitPrior::Half,
-            importance_bound: ImportanceBound::Children,
+            importance_bound: ImportanceBound::Grandchildren,
             unbounded: UnboundedLights::NONE,
             accumulation: Accumulation::Fast,
             min_records: 64,

@@ -67,9 +67,9 @@ pub struct Args {
     #[arg(long, default_value = "importance", value_parser = parse_modulation)]
     pub modulation: Modulation,
     /// The bound the GLT's importance rules weigh a node's children by:
-    /// `children` (their own; the crate's default) or `grandchildren`
-    /// (their children's at even depths).
-    #[arg(long, default_value = "children", value_parser = parse_importance_bound)]
+    /// `children` (their own) or `grandchildren` (their children's at
+    /// even depths; the crate's default).
+    #[arg(long, default_value = "grandchildren", value_parser = parse_importance_bound)]
     pub importance_bound: ImportanceBound,
     /// Light records carry the full contribution `f cos Le w / p` instead of
     /// the paper's `Le w / p`.

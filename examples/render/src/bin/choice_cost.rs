@@ -35,6 +35,7 @@
 //! function divided by the operations it ran is the cost of one.
 
 use clap::Parser;
+use guiding::config::ImportanceBound;
 use guiding::field::GuidingField;
 use guiding::glt::Glt;
 use guiding::{LightChoice, LightId, LightSample, LightSampler, LightTree, ShadingContext};
@@ -42,7 +43,7 @@ use guiding_render::geometry::{Frame, NO_EMITTER, offset_origin};
 use guiding_render::materials::cosine_hemisphere;
 use guiding_render::methods::{self, Method};
 use guiding_render::scene::Scene;
-use guiding_render::{rng, run, scenes, shading_points};
+use guiding_render::{cli, rng, run, scenes, shading_points};
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -92,6 +93,10 @@ struct Args {
         value_delimiter = ','
     )]
     ops: Vec<String>,
+    /// The bound the trained guides' importance rules weigh children by
+    /// (`children` or `grandchildren`, the crate's default).
+    #[arg(long, default_value = "grandchildren", value_parser = cli::parse_importance_bound)]
+    importance_bound: ImportanceBound,
     /// Where the trained guides are kept for the callgrind child.
     #[arg(long, default_value = "out/choice_cost")]
     out: PathBuf,
@@ -501,7 +506,10 @@ fn guides<'t>(
         width: args.width,
         height: args.height,
         budget: run::Budget::Spp(args.train_spp),
-        params: methods::GuideParams::default(),
+        params: methods::GuideParams {
+            importance_bound: args.importance_bound,
+            ..Default::default()
+        },
         seed: 1,
         progress: false,
         guide_files: Default::default(),
