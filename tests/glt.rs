@@ -1816,3 +1816,114 @@ fn a_cut_that_collected_nothing_from_emitters_keeps_its_nodes() {
         (&nodes[..], &[1.0f32][..])
     );
 }
+
+/// The choice does not depend on the unit of power, up to the largest
+/// powers a tree holds: every power (and every recorded value) times
+/// 2^118, which `f32` and `f64` multiply exactly, puts the tree's total
+/// near `f32::MAX` and changes no pmf, untrained or trained, at points a
+/// millimetre from a light (where power over squared distance is far
+/// beyond `f32::MAX`), far away and in between, under both importance
+/// bounds. A rule that divided a power by a squared distance, or summed
+/// such weights, in `f32` would overflow there and fall back to the
+/// power split (the control in the comment below).
+#[test]
+fn the_choice_does_not_depend_on_the_unit_of_power() {
+    const SCALE: f32 = (1u128 << 118) as f32;
+    let mut rng = Rand::new(118);
+    let base: Vec<Emitter> = (0..40)
+        .map(|i| {
+            let p = rng.point(4.0);
+            let power = rng.range(0.1, 10.0);
+            match i % 2 {
+                0 => Emitter::point(p, power),
+                _ => Emitter::area(
+                    Aabb::new(p, p + Vec3::new(0.3, 0.0, 0.3)),
+                    Vec3::new(rng.range(-1.0, 1.0), 1.0, rng.range(-1.0, 1.0)),
+                    0.09,
+                    power,
+                ),
+            }
+        })
+        .collect();
+    let scaled: Vec<Emitter> = base
+        .iter()
+        .map(|e| Emitter {
+            power: e.power * SCALE,
+            ..*e
+        })
+        .collect();
+    let trees = [&base, &scaled].map(|l| LightTree::build(&l[..], BuildHeuristic::Saoh).unwrap());
+    assert!(trees[1].total_power() > 1e37 && trees[1].total_power().is_finite());
+    // Points near lights (1 mm), far away and in the box; with and
+    // without a normal.
+    let mut points = Vec::new();
+    for (i, e) in base.iter().enumerate() {
+        let c = e.bounds.center();
+        let near = c + Vec3::new(1e-3, 1e-3, 0.0);
+        let far = c * 1e4 + Vec3::splat(1e4);
+        let inside = rng.point(5.0);
+        for p in [near, far, inside] {
+            points.push(match i % 3 {
+                0 => ShadingContext::at(p),
+                _ => ShadingContext::on_surface(p, Vec3::new(0.3, 1.0, -0.2)),
+            });
+        }
+    }
+    for bound in [ImportanceBound::Children, ImportanceBound::Grandchildren] {
+        let config = CutConfig {
+            importance_bound: bound,
+            min_records: 0,
+            ..CutConfig::default()
+        };
+        let guides = [0, 1].map(|t| CutRules::new(&trees[t], config).unwrap());
+        let mut cuts = [0, 1].map(|t| guides[t].new_cut());
+        for round in 0..3 {
+            let mut worst = 0.0f64;
+            for ctx in &points {
+                let pmfs = [0, 1].map(|t| {
+                    (0..40u32)
+                        .map(|e| guides[t].pmf_exact(&cuts[t], ctx, LightId::Emitter(e)))
+                        .collect::<Vec<f64>>()
+                });
+                for (a, b) in pmfs[0].iter().zip(&pmfs[1]) {
+                    assert!(b.is_finite(), "{bound:?} round {round}: {b}");
+                    worst = worst.max((a - b).abs() / a.max(1e-300));
+                }
+                let total: f64 = pmfs[1].iter().sum();
+                assert!((total - 1.0).abs() < 1e-9, "{bound:?}: sums to {total}");
+                for u in [0.0f32, 0.3, 0.999] {
+                    let s = guides[1].sample(&cuts[1], ctx, u).unwrap();
+                    assert_eq!(Some(s.pmf), Some(guides[1].pmf(&cuts[1], ctx, s.light)));
+                }
+            }
+            assert!(
+                worst <= 1e-9,
+                "{bound:?} round {round}: relative difference {worst}"
+            );
+            // Train both alike: light e at point k records the same value,
+            // times the scale for the scaled tree.
+            for (k, ctx) in points.iter().enumerate() {
+                let e = (k * 7 + round) as u32 % 40;
+                let v = 1.0
+                    / (1.0
+                        + ctx
+                            .position
+                            .distance_squared(base[e as usize].bounds.center()));
+                guides[0].record(&cuts[0], LightId::Emitter(e), v);
+                guides[1].record(&cuts[1], LightId::Emitter(e), v * SCALE);
+            }
+            for t in 0..2 {
+                guides[t].refine(&mut cuts[t]);
+            }
+        }
+        // The cuts learned (and alike: the pmfs above agree).
+        assert!(
+            cuts[1].nodes().len() > 3,
+            "{bound:?}: {}",
+            cuts[1].nodes().len()
+        );
+        assert_eq!(cuts[0].nodes().len(), cuts[1].nodes().len());
+        // Control (run by hand): `Lanes::sides` weighing by `a / d` in
+        // `f32` instead of scaling by the nearest lane fails this test.
+    }
+}
