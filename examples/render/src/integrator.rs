@@ -128,8 +128,9 @@ fn found_light(
     }
 }
 
-/// The radiance arriving at the camera along `origin + t dir`.
-/// `recorder` is reused between paths (it keeps its storage).
+/// The radiance arriving at the camera along `origin + t dir`, and the
+/// path's non-specular vertices (where it chooses a light) added to
+/// `vertices`. `recorder` is reused between paths (it keeps its storage).
 pub fn radiance<'a>(
     scene: &Scene,
     guides: &Guides<'a>,
@@ -137,6 +138,7 @@ pub fn radiance<'a>(
     mut dir: Vec3,
     s: &mut Sampler,
     recorder: &mut Recorder<'a>,
+    vertices: &mut u64,
 ) -> Vec3 {
     let max_depth = scene.effects.max_depth;
     let train_light = guides.train && (guides.glt.is_some() || guides.field.is_some());
@@ -413,6 +415,7 @@ pub fn radiance<'a>(
     if train_sd {
         recorder.finish();
     }
+    *vertices += u64::from(scattered);
     let l = recorder.estimate();
     if l.is_finite() { l } else { Vec3::ZERO }
 }

@@ -174,6 +174,7 @@ fn run_all(args: &cli::Args) -> Result<(), String> {
         )?;
         if !records.is_empty() {
             println!("{}", report::table(&records));
+            print!("{}", report::work_table(&records));
             print!("{}", report::curve_table(&records));
         }
         println!("{trust}\n");
@@ -197,6 +198,7 @@ fn replot(path: &Path, out: &Path) -> Result<(), String> {
     for name in scenes {
         let records: Vec<Record> = all.iter().filter(|r| r.scene == name).cloned().collect();
         println!("{}", report::table(&records));
+        print!("{}", report::work_table(&records));
         print!("{}", report::curve_table(&records));
         let dir = out.join(name);
         std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
@@ -360,6 +362,7 @@ fn run_scene(
             glt_bytes: r.glt_bytes,
             emitters: scene.lights.len(),
             iterations: r.iterations,
+            vertices: r.vertices,
             curve,
         });
         rendered.push((label, r, e));

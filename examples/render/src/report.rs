@@ -47,6 +47,9 @@ pub struct Record {
     pub emitters: usize,
     /// Training iterations.
     pub iterations: u32,
+    /// Non-specular path vertices rendered, training included (0 where a
+    /// results file predates the count).
+    pub vertices: u64,
     /// The convergence curve (empty with `--no-curve`): what the render
     /// would have delivered at each recorded point.
     pub curve: Vec<CurvePoint>,
@@ -141,6 +144,7 @@ pub fn to_json(records: &[Record]) -> String {
             ("glt_bytes", r.glt_bytes.to_string()),
             ("emitters", r.emitters.to_string()),
             ("iterations", r.iterations.to_string()),
+            ("vertices", r.vertices.to_string()),
             (
                 "curve",
                 format!(
@@ -232,6 +236,7 @@ pub fn from_json(text: &str) -> Result<Vec<Record>, String> {
                 glt_bytes: int("glt_bytes")? as usize,
                 emitters: int("emitters")? as usize,
                 iterations: int("iterations")? as u32,
+                vertices: int("vertices").unwrap_or(0),
                 curve,
             })
         })
@@ -290,6 +295,36 @@ pub fn table(records: &[Record]) -> String {
         out,
         "eff = 1 / (relMSE x seconds); `vs X` = eff / eff of X (above 1: fewer seconds than X to the same error); the reference's own relMSE {floor:.2e} is subtracted"
     );
+    out
+}
+
+/// A plain-text table of what each record's paths cost: non-specular
+/// vertices (where a path chooses a light) per path, and wall time per
+/// such vertex, training included. A method whose paths are longer
+/// renders fewer of them in the same time; this tells that apart from a
+/// costlier vertex. Records without a vertex count are left out.
+pub fn work_table(records: &[Record]) -> String {
+    let mut out = String::new();
+    let counted: Vec<&Record> = records.iter().filter(|r| r.vertices > 0).collect();
+    if counted.is_empty() {
+        return out;
+    }
+    let _ = writeln!(
+        out,
+        "{:<16} {:>14} {:>10}",
+        "work", "vertices/path", "ns/vertex"
+    );
+    for r in counted {
+        let paths = r.spp as f64 * f64::from(r.width) * f64::from(r.height);
+        let _ = writeln!(
+            out,
+            "{:<16} {:>14.3} {:>10.1}",
+            r.method,
+            r.vertices as f64 / paths,
+            r.seconds * 1e9 / r.vertices as f64
+        );
+    }
+    out.push('\n');
     out
 }
 

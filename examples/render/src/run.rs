@@ -129,6 +129,10 @@ pub struct Rendered {
     pub spp_final: u64,
     /// Wall-clock seconds, training and refinement included.
     pub seconds: f64,
+    /// Non-specular path vertices rendered (where a path chooses a
+    /// light), training included: `seconds` over these is the wall time
+    /// per vertex.
+    pub vertices: u64,
     /// Mean luminance of the image.
     pub mean: f64,
     /// Standard error of `mean`.
@@ -143,24 +147,26 @@ pub struct Rendered {
 
 const TILE: u32 = 16;
 
-/// Renders one pass (one sample per pixel) into `out` (RGB triples).
+/// Renders one pass (one sample per pixel) into `out` (RGB triples);
+/// the non-specular vertices of its paths.
 pub fn render_pass(
     scene: &Scene,
     guides: &Guides,
     settings: &Settings,
     pass: u64,
     out: &mut [f32],
-) {
+) -> u64 {
     let (w, h) = (settings.width, settings.height);
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
-    let results: Vec<Vec<Vec3>> = tiles
+    let results: Vec<(Vec<Vec3>, u64)> = tiles
         .par_iter()
         .enumerate()
         .map(|(i, &(x0, y0))| {
             let mut s = Sampler::new(settings.seed, pass, i as u64);
             let mut recorder = Recorder::new();
+            let mut vertices = 0u64;
             let mut px = Vec::with_capacity((TILE * TILE) as usize);
             for y in y0..(y0 + TILE).min(h) {
                 for x in x0..(x0 + TILE).min(w) {
@@ -173,13 +179,14 @@ pub fn render_pass(
                         dir,
                         &mut s,
                         &mut recorder,
+                        &mut vertices,
                     ));
                 }
             }
-            px
+            (px, vertices)
         })
         .collect();
-    for (&(x0, y0), px) in tiles.iter().zip(&results) {
+    for (&(x0, y0), (px, _)) in tiles.iter().zip(&results) {
         let mut k = 0;
         for y in y0..(y0 + TILE).min(h) {
             for x in x0..(x0 + TILE).min(w) {
@@ -189,6 +196,7 @@ pub fn render_pass(
             }
         }
     }
+    results.iter().map(|(_, v)| v).sum()
 }
 
 /// Bytes of whichever learned structures a method has.
@@ -320,6 +328,7 @@ pub fn render_observed<'a>(
     let mut history: VecDeque<Done> = VecDeque::new();
     let mut pass_buf = vec![0.0f32; len];
     let (mut spp, mut sec_per_pass) = (0u64, 0.0f64);
+    let mut vertices = 0u64;
     loop {
         let elapsed = start.elapsed().as_secs_f64() - paused;
         let it = match (trained, settings.budget) {
@@ -361,7 +370,7 @@ pub fn render_observed<'a>(
             }
             let train = trained && !it.is_last;
             let guides = guides(&fixed, &glt, &sd_tree, &field, &settings.params, train);
-            render_pass(scene, &guides, settings, spp, &mut pass_buf);
+            vertices += render_pass(scene, &guides, settings, spp, &mut pass_buf);
             stats.add_pass(&pass_buf);
             let m = mean_luminance(&pass_buf);
             m_sum += m;
@@ -449,6 +458,7 @@ pub fn render_observed<'a>(
         spp,
         spp_final,
         seconds,
+        vertices,
         mean_error: mean_error2.sqrt(),
         iterations: k + 1,
         // For the field: the cuts are the GLT's share, the rest (spatial

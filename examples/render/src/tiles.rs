@@ -121,12 +121,14 @@ pub fn render_tiles(
     // Samples rendered so far, and the pass count whose worth of samples
     // triggers the next `Doubling` refinement.
     let (mut samples, mut next_worth, mut refinements) = (0u64, 1u64, 0u32);
+    let mut vertices = 0u64;
     for chunk in tiles.chunks(WAVE) {
         let guides = guides(&fixed, &glt, &sd_tree, &field, &settings.params, learns);
-        let rendered: Vec<Vec<Moments>> = chunk
+        let rendered: Vec<(Vec<Moments>, u64)> = chunk
             .par_iter()
             .map(|&(x0, y0)| {
                 let mut recorder = Recorder::new();
+                let mut tile_vertices = 0u64;
                 let mut out = Vec::with_capacity((TILE * TILE) as usize);
                 for y in y0..(y0 + TILE).min(h) {
                     for x in x0..(x0 + TILE).min(w) {
@@ -143,16 +145,18 @@ pub fn render_tiles(
                                 dir,
                                 &mut s,
                                 &mut recorder,
+                                &mut tile_vertices,
                             );
                             m.add(l);
                         }
                         out.push(m);
                     }
                 }
-                out
+                (out, tile_vertices)
             })
             .collect();
-        for (&(x0, y0), px) in chunk.iter().zip(&rendered) {
+        for (&(x0, y0), (px, tile_vertices)) in chunk.iter().zip(&rendered) {
+            vertices += tile_vertices;
             let mut k = 0;
             for y in y0..(y0 + TILE).min(h) {
                 for x in x0..(x0 + TILE).min(w) {
@@ -213,6 +217,7 @@ pub fn render_tiles(
         spp,
         spp_final: spp,
         seconds: start.elapsed().as_secs_f64(),
+        vertices,
         mean,
         mean_error,
         iterations: refinements + 1,
