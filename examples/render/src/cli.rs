@@ -241,7 +241,7 @@ pub fn parse_prior(s: &str) -> Result<Prior, String> {
 }
 
 /// Parses `--below-cut`.
-fn parse_below_cut(s: &str) -> Result<BelowCut, String> {
+pub fn parse_below_cut(s: &str) -> Result<BelowCut, String> {
     match s {
         "power" => Ok(BelowCut::Power),
         "importance" => Ok(BelowCut::Importance),

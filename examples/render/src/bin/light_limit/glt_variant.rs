@@ -1,7 +1,7 @@
 //! A GLT configuration to measure, from a `key=value` list.
 
+use crate::cli;
 use crate::methods::GuideParams;
-use guiding::cut::{BelowCut, ImportanceBound, Modulation, Prior};
 use guiding::spatial::SpatialFilter;
 
 /// One GLT configuration and how long it trains.
@@ -38,47 +38,18 @@ impl GltVariant {
             let (k, val) = kv
                 .split_once('=')
                 .ok_or_else(|| format!("`{kv}`: expected key=value"))?;
-            let num = || val.parse::<f64>().map_err(|e| format!("`{kv}`: {e}"));
+            let in_kv = |e: String| format!("`{kv}`: {e}");
+            let num = || val.parse::<f64>().map_err(|e| in_kv(e.to_string()));
             match k {
                 "sigma" => v.params.sigma = num()?,
                 "alpha" => v.params.alpha = num()?,
                 "threshold" => v.params.glt_spatial_threshold = num()?,
-                "prior" => {
-                    v.params.prior = pick(
-                        kv,
-                        val,
-                        [("power", Prior::Power), ("importance", Prior::Importance)],
-                    )?
-                }
-                "below" => {
-                    v.params.below_cut = pick(
-                        kv,
-                        val,
-                        [
-                            ("power", BelowCut::Power),
-                            ("importance", BelowCut::Importance),
-                        ],
-                    )?
-                }
-                "modulation" => {
-                    v.params.modulation = pick(
-                        kv,
-                        val,
-                        [
-                            ("none", Modulation::None),
-                            ("importance", Modulation::Importance),
-                        ],
-                    )?
-                }
+                // The render example's own parsers: one list of names.
+                "prior" => v.params.prior = cli::parse_prior(val).map_err(in_kv)?,
+                "below" => v.params.below_cut = cli::parse_below_cut(val).map_err(in_kv)?,
+                "modulation" => v.params.modulation = cli::parse_modulation(val).map_err(in_kv)?,
                 "bound" => {
-                    v.params.importance_bound = pick(
-                        kv,
-                        val,
-                        [
-                            ("children", ImportanceBound::Children),
-                            ("grandchildren", ImportanceBound::Grandchildren),
-                        ],
-                    )?
+                    v.params.importance_bound = cli::parse_importance_bound(val).map_err(in_kv)?
                 }
                 "record" => {
                     v.params.contribution_records =

@@ -33,7 +33,7 @@ mod glt_variant;
 mod per_point_m;
 
 mod variance;
-use guiding_render::{geometry, methods, rng, run, scene, scenes, shading_points};
+use guiding_render::{cli, geometry, methods, rng, run, scene, scenes, shading_points};
 
 use brute_force::PointTerms;
 use clap::Parser;
