@@ -30,6 +30,7 @@ pub mod crossing;
 pub mod film;
 pub mod frames;
 pub mod geometry;
+pub mod glt_variant;
 pub mod integrator;
 pub mod json;
 pub mod lights;

@@ -40,6 +40,7 @@ use guiding::field::GuidingField;
 use guiding::glt::Glt;
 use guiding::{LightChoice, LightId, LightSample, LightSampler, LightTree, ShadingContext};
 use guiding_render::geometry::{Frame, NO_EMITTER, offset_origin};
+use guiding_render::glt_variant::GltVariant;
 use guiding_render::materials::cosine_hemisphere;
 use guiding_render::methods::{self, Method};
 use guiding_render::scene::Scene;
@@ -97,6 +98,12 @@ struct Args {
     /// (`children` or `grandchildren`, the crate's default).
     #[arg(long, default_value = "grandchildren", value_parser = cli::parse_importance_bound)]
     importance_bound: ImportanceBound,
+    /// The trained guides' rules, as `light_limit --glt` takes them
+    /// (space-separated `key=value`, e.g. `below=power prior=power` or
+    /// `rules=paper`), applied after `--importance-bound`: what each rule
+    /// costs, beside what `light_limit` says it is worth.
+    #[arg(long, default_value = "")]
+    glt: String,
     /// Where the trained guides are kept for the callgrind child.
     #[arg(long, default_value = "out/choice_cost")]
     out: PathBuf,
@@ -502,14 +509,14 @@ fn guides<'t>(
             GuidingField::from_bytes(&read(&fp)?, &scene.light_tree).map_err(|e| e.to_string())?;
         return Ok((glt, field));
     }
+    let mut base = GltVariant::defaults(args.train_spp);
+    base.params.importance_bound = args.importance_bound;
+    let params = base.with(&args.glt)?.params;
     let settings = |_m: Method| run::Settings {
         width: args.width,
         height: args.height,
         budget: run::Budget::Spp(args.train_spp),
-        params: methods::GuideParams {
-            importance_bound: args.importance_bound,
-            ..Default::default()
-        },
+        params: params.clone(),
         seed: 1,
         progress: false,
         guide_files: Default::default(),

@@ -29,16 +29,15 @@
 
 mod breakdown;
 mod brute_force;
-mod glt_variant;
 mod per_point_m;
 
 mod variance;
-use guiding_render::{cli, geometry, methods, rng, run, scene, scenes, shading_points};
+use guiding_render::{geometry, methods, rng, run, scene, scenes, shading_points};
 
 use brute_force::PointTerms;
 use clap::Parser;
-use glt_variant::GltVariant;
 use guiding::{LightChoice, LightId, LightSampler, ShadingContext};
+use guiding_render::glt_variant::GltVariant;
 use methods::Method;
 use rayon::prelude::*;
 use std::fmt::Write as _;

@@ -33,7 +33,13 @@ impl GltVariant {
     /// render example's `--paper-rules`), min-records, threshold,
     /// train-spp) applied in order to the defaults.
     pub fn parse(spec: &str, train_spp: u64) -> Result<Self, String> {
-        let mut v = Self::defaults(train_spp);
+        Self::defaults(train_spp).with(spec)
+    }
+
+    /// This configuration with the settings of `spec` (as
+    /// [`GltVariant::parse`] reads them) applied in order, named for them.
+    pub fn with(self, spec: &str) -> Result<Self, String> {
+        let mut v = self;
         for kv in spec.split_whitespace() {
             let (k, val) = kv
                 .split_once('=')
