@@ -516,7 +516,7 @@ fn guides<'t>(
         width: args.width,
         height: args.height,
         budget: run::Budget::Spp(args.train_spp),
-        params: params.clone(),
+        params,
         seed: 1,
         progress: false,
         guide_files: Default::default(),
