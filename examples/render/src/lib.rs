@@ -18,6 +18,8 @@
 //! counterpart's), `plot` (convergence plots), `sheet` (comparison
 //! sheet), `raster` + `text` (the canvas and the font both draw with),
 //! `shading_points` (the first non-specular vertices of camera paths),
+//! `glt_variant` (a GLT configuration from `key=value` settings, which
+//! `light_limit --glt` and `choice_cost --glt` read),
 //! `animation` and `frames` (an animated scene and its frames rendered
 //! three ways).
 #![allow(missing_docs)]
